@@ -1,0 +1,357 @@
+"""Public curvature API: Walker's HHJ shape operator, the HHJ surface Hessian,
+per-face curvatures, and the drop-in ``principal_curvature``.
+
+Sign convention (libigl's and Walker's): with outward normals (F oriented so
+that ``(x1 - x0) × (x2 - x0)`` points out), a sphere of radius R has shape
+operator ``P / R`` and principal curvatures ``+1/R``.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .hhj import HHJProjection, clamped_load, face_tensors
+from .mesh import TriangleMesh, as_mesh, per_vertex_array
+
+__all__ = [
+    "shape_operator", "surface_hessian", "principal_curvature",
+    "face_principal_curvature", "face_mean_curvature", "face_gaussian_curvature",
+    "principal_from_shape_operator", "vertex_shape_operator",
+]
+
+
+# --------------------------------------------------------------------------- helpers
+def _boundary_partition(mesh, boundary_normals, boundary_shape_operator, simply_supported):
+    """Return (clamped_with_data (#E,) bool, simply_supported_edges (#E,) bool)."""
+    bnd = mesh.boundary_edges
+    ss_edges = np.zeros(mesh.n_edges, dtype=bool)
+    if simply_supported is not None:
+        if boundary_shape_operator is None:
+            raise ValueError("simply_supported needs boundary_shape_operator (the data on those edges)")
+        flag = np.asarray(simply_supported)
+        if flag.shape != (mesh.n_vertices,):
+            raise ValueError(f"simply_supported must have shape ({mesh.n_vertices},), got {flag.shape}")
+        if flag.dtype != bool:
+            raise TypeError(f"simply_supported must be a boolean array, got dtype {flag.dtype}")
+        ss_edges = bnd & flag[mesh.edges[:, 0]] & flag[mesh.edges[:, 1]]
+    elif boundary_shape_operator is not None:
+        if boundary_normals is not None:
+            raise ValueError("both boundary_normals and boundary_shape_operator given: pass "
+                             "simply_supported (#V bool) to say which boundary edges are simply supported")
+        ss_edges = bnd.copy()
+    clamped = bnd & ~ss_edges if boundary_normals is not None else np.zeros_like(bnd)
+    return clamped, ss_edges
+
+
+def _data_rows(mesh, A, edge_mask, name):
+    """Check that per-vertex data is finite on the endpoints of the masked edges."""
+    verts = np.unique(mesh.edges[edge_mask].ravel())
+    bad = ~np.isfinite(A[verts].reshape(len(verts), -1)).all(axis=1)
+    if bad.any():
+        raise ValueError(f"{name} is NaN or inf at boundary vertex {int(verts[bad][0])}, "
+                         "where it is needed")
+    return verts
+
+
+def _boundary_face_and_conormal(mesh, e):
+    f = mesh.edge_faces[e, 0]
+    i = mesh.edge_local_index[e, 0]
+    neg = f < 0
+    f = np.where(neg, mesh.edge_faces[e, 1], f)
+    i = np.where(neg, mesh.edge_local_index[e, 1], i)
+    return f, mesh.conormals[f, i]
+
+
+def _normalised_boundary_normals(mesh, boundary_normals, clamped):
+    N = per_vertex_array(mesh, boundary_normals, "boundary_normals", (3,))
+    verts = _data_rows(mesh, N, clamped, "boundary_normals")
+    norm = np.linalg.norm(N[verts], axis=1)
+    if (norm < 1e-12).any():
+        raise ValueError(f"boundary_normals has a zero vector at vertex {int(verts[norm < 1e-12][0])}")
+    N = N.copy()
+    N[verts] /= norm[:, None]
+    # Orientation check: the data must point to the same side as the faces.
+    e = np.flatnonzero(clamped)
+    f, _ = _boundary_face_and_conormal(mesh, e)
+    for col in (0, 1):
+        v = mesh.edges[e, col]
+        dots = np.einsum("ma,ma->m", N[v], mesh.face_normals[f])
+        if (dots <= 0).any():
+            j = int(np.flatnonzero(dots <= 0)[0])
+            raise ValueError(
+                f"boundary_normals at vertex {int(v[j])} points away from the normal of its "
+                f"boundary face {int(f[j])} (dot {dots[j]:.3f}): normals must agree with F's orientation")
+    return N
+
+
+def _simply_supported_values(mesh, boundary_shape_operator, ss_edges):
+    """ρ_e^k = -ν_T^k · mean_e(nᵀ S~ n), eq. (5.18) with P1-interpolated S~. Returns (#E, 3)."""
+    S = per_vertex_array(mesh, boundary_shape_operator, "boundary_shape_operator", (3, 3))
+    _data_rows(mesh, S, ss_edges, "boundary_shape_operator")
+    rho = np.zeros((mesh.n_edges, 3))
+    e = np.flatnonzero(ss_edges)
+    f, n = _boundary_face_and_conormal(mesh, e)
+    Sm = 0.5 * (S[mesh.edges[e, 0]] + S[mesh.edges[e, 1]])
+    kn = np.einsum("ma,mab,mb->m", n, Sm, n)
+    rho[e] = -mesh.face_normals[f] * kn[:, None]
+    return rho
+
+
+def _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver):
+    clamped, ss_edges = _boundary_partition(mesh, boundary_normals, boundary_shape_operator,
+                                            simply_supported)
+    proj = HHJProjection(mesh, fixed_edges=ss_edges, solver=solver)
+    X = mesh.V
+    load = proj.plain_boundary_load(X)
+    if clamped.any():
+        N = _normalised_boundary_normals(mesh, boundary_normals, clamped)
+        # ξ^k = ∇_Γ id^k = P e_k, P = I - ν~ ⊗ ν~: gradients of the 3 coordinates.
+        P = np.eye(3)[None] - N[:, :, None] * N[:, None, :]   # (#V, 3, 3): row k = ξ^k
+        P[~np.isfinite(P)] = 0.0
+        load[clamped] = clamped_load(mesh, clamped, P)[clamped]
+    fixed_values = _simply_supported_values(mesh, boundary_shape_operator, ss_edges) \
+        if ss_edges.any() else None
+    s = proj.solve(X, load=load, fixed_values=fixed_values)   # (#E, 3): σ^k DOFs
+    # S_h|_T = -Σ_k ν_T^k σ^k|_T: contract the DOFs with the face normal first.
+    c = -np.einsum("fjk,fk->fj", s[mesh.face_edges], mesh.face_normals)
+    S = np.einsum("fj,fjab->fab", c, proj.phi)
+    return S
+
+
+# --------------------------------------------------------------------------- public API
+def shape_operator(V, F, *, boundary_normals=None, boundary_shape_operator=None,
+                   simply_supported=None, solver="auto"):
+    """Walker's HHJ approximation S_h of the shape operator ∇_Γν, one tensor per face.
+
+    Solves ``A s^k = -B X^k + g^k`` for the three coordinate functions
+    (Walker eq. 5.14 for closed surfaces, eq. 5.19 with boundary) and sets
+    ``S_h|_T = -Σ_k ν_T^k σ^k_h|_T`` (eq. 5.12).  Converges like O(h) in L2 on
+    irregular piecewise-linear meshes (Theorem 5.2/5.3).
+
+    Parameters
+    ----------
+    V : (#V, 3) array_like of float
+        Vertex positions.
+    F : (#F, 3) array_like of int
+        Consistently oriented triangles (never reordered).
+    boundary_normals : (#V, 3) array_like, optional
+        True unit surface normals at (at least) the boundary vertices; boundary
+        edges not simply supported become *clamped* edges with this data
+        (Σ_c of eq. 5.19, normals interpolated linearly along each edge).
+        Must agree with F's orientation.
+    boundary_shape_operator : (#V, 3, 3) array_like, optional
+        True shape operator ∇_Γν at (at least) the boundary vertices; boundary
+        edges become *simply supported* (Σ_s, eq. 5.18): their DOFs are fixed
+        to ``-ν_T^k nᵀS~n``.
+    simply_supported : (#V,) bool array, optional
+        With both data arrays: boundary edges whose two endpoints are flagged
+        are simply supported, the other boundary edges clamped.
+    solver : {"auto", "cg", "direct"}
+        Linear solver for A (see :func:`igl_hhj.hhj.solve_spd`).
+
+    Returns
+    -------
+    S : (#F, 3, 3) float64
+        Symmetric tensors, tangential to each face (``S[f] @ ν_f ≈ 0``).
+
+    Notes
+    -----
+    Without boundary data, boundary edges get the *plain assembly* (the face
+    normal stands in for the true one); the method still runs on any mesh but
+    its rate near the boundary drops to about O(h^1/2).  Triangles with all
+    three vertices on the boundary (excluded by Walker's Property 1) are
+    allowed: A stays SPD; their values are least accurate.
+    """
+    mesh = as_mesh(V, F)
+    return _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver)
+
+
+def surface_hessian(V, F, w, *, boundary_gradient=None, solver="auto"):
+    """HHJ projection of the surface Hessian ∇_Γ∇_Γ w of a P1 function (Walker eq. 4.9).
+
+    Parameters
+    ----------
+    V, F : mesh (see :func:`shape_operator`).
+    w : (#V,) or (#V, k) array_like
+        Vertex values of one (or k) piecewise-linear functions.
+    boundary_gradient : (#V, 3) or (#V, k, 3) array_like, optional
+        True surface gradient of w at (at least) the boundary vertices: clamped
+        boundary data (eq. 3.12's Σ_c term). Without it, the plain assembly.
+    solver : {"auto", "cg", "direct"}
+
+    Returns
+    -------
+    H : (#F, 3, 3) (or (#F, k, 3, 3)) float64, symmetric tangential tensors.
+    """
+    mesh = as_mesh(V, F)
+    w_arr = np.asarray(w)
+    single = w_arr.ndim == 1
+    if single:
+        W = per_vertex_array(mesh, w_arr, "w")[:, None]
+    else:
+        if w_arr.ndim != 2:
+            raise ValueError(f"w must have shape (#V,) or (#V, k), got {w_arr.shape}")
+        W = per_vertex_array(mesh, w_arr, "w", (w_arr.shape[1],))
+    ref = mesh.referenced_vertices
+    if not np.isfinite(W[ref]).all():
+        raise ValueError(f"w has NaN or inf at vertex {int(np.flatnonzero(~np.isfinite(W).all(1) & ref)[0])}")
+    W = np.where(np.isfinite(W), W, 0.0)
+    proj = HHJProjection(mesh, solver=solver)
+    load = proj.plain_boundary_load(W)
+    if boundary_gradient is not None and mesh.has_boundary:
+        G = np.asarray(boundary_gradient)
+        G = per_vertex_array(mesh, G, "boundary_gradient", (3,))[:, None, :] if single \
+            else per_vertex_array(mesh, G, "boundary_gradient", (W.shape[1], 3))
+        bnd = mesh.boundary_edges
+        _data_rows(mesh, G, bnd, "boundary_gradient")
+        G = np.where(np.isfinite(G), G, 0.0)
+        load[bnd] = clamped_load(mesh, bnd, G)[bnd]
+    s = proj.solve(W, load=load)
+    H = face_tensors(mesh, s, proj.phi)
+    return H[:, 0] if single else H
+
+
+def principal_from_shape_operator(S, normals):
+    """Principal curvatures and directions of tangential tensors.
+
+    Parameters
+    ----------
+    S : (n, 3, 3) symmetric tensors (tangential to ``normals``).
+    normals : (n, 3) unit normals of the tangent planes.
+
+    Returns
+    -------
+    PD1, PD2 : (n, 3) unit principal directions (PD2 = normal × PD1).
+    PV1, PV2 : (n,) principal curvatures, PV1 ≥ PV2: the eigenvalues of the
+        tangential 2×2 block of S.
+    """
+    N = normals
+    # Tangent frame: e1 ⟂ N from the coordinate axis least aligned with N.
+    ax = np.eye(3)[np.argmin(np.abs(N), axis=1)]
+    e1 = np.cross(N, ax)
+    e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
+    e2 = np.cross(N, e1)
+    E = np.stack([e1, e2], axis=2)                      # (n, 3, 2)
+    S2 = np.einsum("nai,nab,nbj->nij", E, S, E)
+    S2 = 0.5 * (S2 + np.swapaxes(S2, 1, 2))
+    w, U = np.linalg.eigh(S2)                           # ascending
+    PV1, PV2 = w[:, 1], w[:, 0]
+    PD1 = np.einsum("nai,ni->na", E, U[:, :, 1])
+    PD1 /= np.linalg.norm(PD1, axis=1, keepdims=True)
+    PD2 = np.cross(N, PD1)
+    return PD1, PD2, PV1, PV2
+
+
+def face_principal_curvature(V, F, **boundary):
+    """Per-face principal curvatures and directions from the HHJ shape operator.
+
+    Keyword arguments are those of :func:`shape_operator`.
+
+    Returns
+    -------
+    PD1, PD2 : (#F, 3) unit directions of maximal / minimal curvature in the
+        face plane (PD2 = ν_T × PD1).
+    PV1, PV2 : (#F,) principal curvatures κ1 ≥ κ2.
+    """
+    mesh = as_mesh(V, F)
+    S = _shape_operator(mesh, boundary.get("boundary_normals"), boundary.get("boundary_shape_operator"),
+                        boundary.get("simply_supported"), boundary.get("solver", "auto"))
+    return principal_from_shape_operator(S, mesh.face_normals)
+
+
+def face_mean_curvature(V, F, **boundary):
+    """Per-face mean curvature H = (κ1 + κ2)/2 = tr(S_h)/2 (Walker's κ^a / 2), shape (#F,)."""
+    S = shape_operator(V, F, **boundary)
+    return 0.5 * np.trace(S, axis1=1, axis2=2)
+
+
+def face_gaussian_curvature(V, F, **boundary):
+    """Per-face Gauss curvature K = κ1 κ2 = det(S_h + ν_T ⊗ ν_T) (Walker eq. 6.1), shape (#F,)."""
+    mesh = as_mesh(V, F)
+    S = shape_operator(mesh.V, mesh.F, **boundary)
+    nu = mesh.face_normals
+    return np.linalg.det(S + nu[:, :, None] * nu[:, None, :])
+
+
+def vertex_shape_operator(mesh, S):
+    """Recover per-vertex tensors from face tensors.
+
+    Area-weighted average over the incident faces of the face tensors
+    projected onto the vertex tangent plane, ``S_v = Σ_T |T| P_v S_T P_v / Σ_T |T|``
+    with ``P_v = I - N_v ⊗ N_v`` and N_v the area-weighted vertex normal
+    (``igl.per_vertex_normals``).  This is a lumped-mass L2 projection onto P1;
+    it converges at the same O(h) rate as S_h (tests measure it).
+
+    Returns
+    -------
+    Sv : (#V, 3, 3) float64 (NaN rows for unreferenced vertices)
+    N : (#V, 3) vertex normals used
+    """
+    N = mesh.vertex_normals
+    w = np.repeat(mesh.face_areas, 3)
+    v = mesh.F.ravel()
+    Sc = np.repeat(S, 3, axis=0)                         # corners, (3#F, 3, 3)
+    acc = np.zeros((mesh.n_vertices, 9))
+    for j in range(9):  # 9 tensor components, vectorised over all corners
+        acc[:, j] = np.bincount(v, weights=w * Sc[:, j // 3, j % 3], minlength=mesh.n_vertices)
+    wsum = np.bincount(v, weights=w, minlength=mesh.n_vertices)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        Sv = (acc / wsum[:, None]).reshape(-1, 3, 3)
+    P = np.eye(3)[None] - N[:, :, None] * N[:, None, :]
+    Sv = P @ Sv @ P
+    return Sv, N
+
+
+def principal_curvature(V, F, radius=5, useKring=True, *, boundary_normals=None,
+                        boundary_shape_operator=None, simply_supported=None, solver="auto"):
+    """Drop-in replacement for ``igl.principal_curvature`` (libigl ≥ 2.5.4 / 2.6).
+
+    Same call forms, same return tuple, shapes, dtypes, ordering and sign, but
+    the values come from Walker's convergent HHJ shape operator
+    (:func:`shape_operator`) recovered at the vertices by
+    :func:`vertex_shape_operator` (area-weighted average of the face tensors
+    projected onto the vertex tangent plane), then a 2×2 eigen-problem.
+
+    Parameters
+    ----------
+    V : (#V, 3) array_like
+        Vertex positions.
+    F : (#F, 3) array_like
+        Triangle indices.
+    radius : int, default 5
+        Accepted for compatibility and **ignored**: the HHJ method has no
+        neighbourhood size.  The recovery always uses the incident faces.
+    useKring : bool, default True
+        Accepted for compatibility and **ignored** (see ``radius``).
+    boundary_normals, boundary_shape_operator, simply_supported, solver
+        Keyword-only extras, see :func:`shape_operator`.
+
+    Returns
+    -------
+    PD1 : (#V, 3) float64, unit direction of maximal curvature
+    PD2 : (#V, 3) float64, unit direction of minimal curvature (N × PD1)
+    PV1 : (#V,) float64, maximal curvature
+    PV2 : (#V,) float64, minimal curvature (PV1 ≥ PV2)
+    bad_vertices : list of int
+        Vertices without a value: the unreferenced ones, whose rows are NaN.
+        Empty for a mesh without unreferenced vertices.
+
+    Positive curvature on a sphere with outward normals, as libigl.
+    """
+    if isinstance(radius, (bool, np.bool_)) or not isinstance(radius, (int, np.integer)):
+        raise TypeError(f"radius must be an int (as in igl.principal_curvature), got {type(radius).__name__}")
+    if not isinstance(useKring, (bool, np.bool_)):
+        raise TypeError(f"useKring must be a bool (as in igl.principal_curvature), got {type(useKring).__name__}")
+    mesh = as_mesh(V, F)
+    S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver)
+    Sv, N = vertex_shape_operator(mesh, S)
+    ref = mesh.referenced_vertices
+    nV = mesh.n_vertices
+    PD1 = np.full((nV, 3), np.nan)
+    PD2 = np.full((nV, 3), np.nan)
+    PV1 = np.full(nV, np.nan)
+    PV2 = np.full(nV, np.nan)
+    d1, d2, k1, k2 = principal_from_shape_operator(Sv[ref], N[ref])
+    PD1[ref], PD2[ref], PV1[ref], PV2[ref] = d1, d2, k1, k2
+    bad = np.flatnonzero(~ref).tolist()
+    return (np.ascontiguousarray(PD1), np.ascontiguousarray(PD2),
+            np.ascontiguousarray(PV1), np.ascontiguousarray(PV2), bad)

@@ -1,0 +1,314 @@
+"""The lowest-order surface Hellan–Herrmann–Johnson (HHJ) layer: one DOF per
+unique edge, over libigl's mesh topology.
+
+Source: S. W. Walker, *Approximating the shape operator with the surface HHJ
+element* (paper 000), §3–§5, made concrete in ``shared/design/hhj_lowest_order.md``.
+
+The space ``V_h`` holds piecewise-constant symmetric tangential 3×3 tensors whose
+normal–normal component ``nᵀσn`` is single valued across every edge (each face
+uses its own outward conormal).  The DOF of edge ``e`` is that value ``σ^nn_e``.
+The local basis on face ``T`` dual to its three edge DOFs is
+
+    φ_j = sym(t_a ⊗ t_b) / ((n_j·t_a)(n_j·t_b)),   {a, b} = the other two edges,
+
+so that ``n_iᵀ φ_j n_i = δ_ij``.  With it,
+
+* ``A[e, e'] = Σ_T |T| φ_e : φ_e'`` (the bilinear form ``a(·,·)``, eq. 3.8/4.7),
+* ``B[e, v] = Σ_{T∋e} l_e n_{e,T}·∇λ_v|_T`` (``b_h(φ_e, λ_v)`` on flat P1
+  triangles: the element Hessian vanishes and only the conormal-derivative
+  jump across ``e`` survives; a boundary edge keeps its one-sided value),
+
+and the HHJ projection of the surface Hessian of a P1 function ``w`` solves
+``A s = -B w + g`` (eq. 4.9 / 5.19), where ``g`` carries clamped boundary data
+and fixed (simply supported) DOFs are moved to the right-hand side.
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from .mesh import TriangleMesh
+
+__all__ = [
+    "local_basis", "mass_matrix", "jump_matrix", "face_tensors", "nn_moments",
+    "clamped_load", "HHJProjection", "solve_spd", "SolverDidNotConverge",
+]
+
+
+class SolverDidNotConverge(RuntimeError):
+    """Raised when the preconditioned CG solve does not reach its tolerance."""
+
+
+def _sym_outer(u, v):
+    """sym(u ⊗ v) = (u vᵀ + v uᵀ)/2 for stacked vectors (..., 3) → (..., 3, 3)."""
+    uv = u[..., :, None] * v[..., None, :]
+    return 0.5 * (uv + np.swapaxes(uv, -1, -2))
+
+
+def local_basis(mesh: TriangleMesh):
+    """Local HHJ basis tensors of every face.
+
+    Returns
+    -------
+    phi : (#F, 3, 3, 3) float64
+        ``phi[f, j]`` is the 3×3 tensor φ_j on face f dual to edge j
+        (the edge opposite corner j): ``n_iᵀ φ_j n_i = δ_ij``, symmetric and
+        tangential (``φ_j ν_T = 0``).
+    """
+    t = mesh.edge_tangents      # (#F, 3, 3)
+    n = mesh.conormals          # (#F, 3, 3)
+    a = [1, 2, 0]
+    b = [2, 0, 1]
+    ta, tb = t[:, a], t[:, b]
+    denom = np.einsum("fjk,fjk->fj", n, ta) * np.einsum("fjk,fjk->fj", n, tb)
+    return _sym_outer(ta, tb) / denom[:, :, None, None]
+
+
+def _assemble(rows, cols, vals, shape):
+    return sp.coo_matrix((vals.ravel(), (rows.ravel(), cols.ravel())), shape=shape).tocsr()
+
+
+def mass_matrix(mesh: TriangleMesh, phi=None):
+    """The HHJ "mass" matrix A (#E × #E, SPD, ≤ 5 nonzeros per row).
+
+    ``A[e, e'] = Σ_T |T| φ_e : φ_e'`` (Frobenius product), Walker eq. (5.14)."""
+    if phi is None:
+        phi = local_basis(mesh)
+    Aloc = np.einsum("fiab,fjab->fij", phi, phi) * mesh.face_areas[:, None, None]
+    FE = mesh.face_edges
+    rows = np.broadcast_to(FE[:, :, None], Aloc.shape)
+    cols = np.broadcast_to(FE[:, None, :], Aloc.shape)
+    return _assemble(rows, cols, Aloc, (mesh.n_edges, mesh.n_edges))
+
+
+def jump_matrix(mesh: TriangleMesh):
+    """The matrix B (#E × #V) of ``b_h(φ_e, λ_v)`` for P1 hat functions λ_v.
+
+    ``B[e, v] = Σ_{T∋e} l_e n_{e,T}·∇λ_v|_T``: row e is the jump of the
+    conormal derivative across e times l_e (one-sided on boundary edges)."""
+    l = mesh.edge_lengths
+    n = mesh.conormals
+    Bloc = -(l[:, :, None] * l[:, None, :]) * np.einsum("fia,fca->fic", n, n) \
+        / mesh.face_double_areas[:, None, None]
+    rows = np.broadcast_to(mesh.face_edges[:, :, None], Bloc.shape)
+    cols = np.broadcast_to(mesh.F[:, None, :], Bloc.shape)
+    return _assemble(rows, cols, Bloc, (mesh.n_edges, mesh.n_vertices))
+
+
+def face_tensors(mesh: TriangleMesh, coeffs, phi=None):
+    """Evaluate HHJ functions face by face.
+
+    Parameters
+    ----------
+    coeffs : (#E,) or (#E, k) edge DOFs σ^nn.
+
+    Returns
+    -------
+    sigma : (#F, 3, 3) or (#F, k, 3, 3) float64, ``Σ_j coeffs[e(f, j)] φ_j``.
+    """
+    if phi is None:
+        phi = local_basis(mesh)
+    c = np.asarray(coeffs)[mesh.face_edges]  # (#F, 3) or (#F, 3, k)
+    if c.ndim == 2:
+        return np.einsum("fj,fjab->fab", c, phi)
+    return np.einsum("fjk,fjab->fkab", c, phi)
+
+
+def nn_moments(mesh: TriangleMesh, sigma):
+    """Normal–normal trace ``n_iᵀ σ_f n_i`` of face tensors on each face's edges.
+
+    Parameters
+    ----------
+    sigma : (#F, 3, 3) face tensors
+
+    Returns
+    -------
+    (#F, 3) float64: entry (f, i) is the nn-component on edge i of face f.
+    For a member of V_h the two faces of an interior edge agree."""
+    n = mesh.conormals
+    return np.einsum("fia,fab,fib->fi", n, sigma, n)
+
+
+def clamped_load(mesh: TriangleMesh, edge_mask, gradient):
+    """Clamped boundary load ``g_e = ∫_e n·ξ ds`` for P1-interpolated data ξ.
+
+    Parameters
+    ----------
+    edge_mask : (#E,) bool, edges receiving data (boundary edges).
+    gradient : (#V, k, 3) surface gradients ξ of k functions at the vertices
+        (rows of vertices not on a masked edge are ignored).
+
+    Returns
+    -------
+    g : (#E, k) float64, zero off the mask.  Exact for linear ξ along the edge.
+    """
+    k = gradient.shape[1]
+    g = np.zeros((mesh.n_edges, k))
+    e = np.flatnonzero(edge_mask)
+    if e.size == 0:
+        return g
+    f = mesh.edge_faces[e, 0]
+    f = np.where(f >= 0, f, mesh.edge_faces[e, 1])
+    i = np.where(mesh.edge_faces[e, 0] >= 0, mesh.edge_local_index[e, 0], mesh.edge_local_index[e, 1])
+    n = mesh.conormals[f, i]                      # (m, 3)
+    va, vb = mesh.edges[e, 0], mesh.edges[e, 1]
+    xi = 0.5 * (gradient[va] + gradient[vb])      # (m, k, 3) mean over the edge
+    g[e] = mesh.unique_edge_lengths[e, None] * np.einsum("ma,mka->mk", n, xi)
+    return g
+
+
+def solve_spd(A, R, *, method="auto", rtol=1e-11, maxiter=None):
+    """Solve ``A X = R`` for an SPD sparse A and all columns of R at once.
+
+    Parameters
+    ----------
+    A : (n, n) scipy.sparse SPD matrix
+    R : (n,) or (n, k) right-hand sides
+    method : {"auto", "cg", "direct"}
+        "cg": Jacobi-preconditioned conjugate gradients, vectorised over the
+        k columns (one sparse mat-mat product per iteration).
+        "direct": sparse LU (``scipy.sparse.linalg.splu``), for small systems.
+        "auto": direct below 20 000 unknowns, CG above.
+    rtol : float
+        CG stops when ``‖r_j‖ ≤ rtol ‖R_j‖`` for every column j.
+    maxiter : int, optional
+        CG iteration cap (default ``max(1000, 10 sqrt(n))``).
+
+    Raises
+    ------
+    SolverDidNotConverge
+        CG did not reach ``rtol`` within ``maxiter`` iterations.
+    """
+    R = np.asarray(R, dtype=np.float64)
+    vec = R.ndim == 1
+    if vec:
+        R = R[:, None]
+    n = A.shape[0]
+    if method == "auto":
+        method = "direct" if n <= 20000 else "cg"
+    if method == "direct":
+        if n == 0:
+            X = np.zeros_like(R)
+        else:
+            X = spla.splu(sp.csc_matrix(A)).solve(R)
+    elif method == "cg":
+        X = _block_pcg(sp.csr_matrix(A), R, rtol, maxiter)
+    else:
+        raise ValueError(f"unknown solver method {method!r}; use 'auto', 'cg' or 'direct'")
+    return X[:, 0] if vec else X
+
+
+def _block_pcg(A, R, rtol, maxiter):
+    n, k = R.shape
+    if maxiter is None:
+        maxiter = max(1000, int(10 * np.sqrt(max(n, 1))))
+    dinv = 1.0 / A.diagonal()
+    X = np.zeros((n, k))
+    r = R.copy()
+    bnorm = np.linalg.norm(R, axis=0)
+    tol = rtol * bnorm
+    active = np.linalg.norm(r, axis=0) > tol
+    if not active.any():
+        return X
+    z = dinv[:, None] * r
+    p = z.copy()
+    rz = np.einsum("ij,ij->j", r, z)
+    for it in range(maxiter):
+        q = A @ p
+        pq = np.einsum("ij,ij->j", p, q)
+        alpha = np.where(active, rz / np.where(active, pq, 1.0), 0.0)
+        X += alpha * p
+        r -= alpha * q
+        rnorm = np.linalg.norm(r, axis=0)
+        active = rnorm > tol
+        if not active.any():
+            return X
+        z = dinv[:, None] * r
+        rz_new = np.einsum("ij,ij->j", r, z)
+        beta = np.where(active, rz_new / np.where(active, rz, 1.0), 0.0)
+        rz = rz_new
+        p = z + beta * p
+    worst = float(np.max(rnorm / np.where(bnorm > 0, bnorm, 1.0)))
+    raise SolverDidNotConverge(
+        f"Jacobi-preconditioned CG did not converge in {maxiter} iterations "
+        f"(relative residual {worst:.2e} > {rtol:.1e}); the mesh may contain "
+        f"near-degenerate triangles. Try solver='direct'.")
+
+
+class HHJProjection:
+    """HHJ projection of surface Hessians of P1 functions on one mesh.
+
+    Holds A, B and the boundary partition so that several right-hand sides
+    (e.g. the three coordinate functions) share one assembly.
+
+    Parameters
+    ----------
+    mesh : TriangleMesh
+    fixed_edges : (#E,) bool, optional
+        Simply supported boundary edges: their DOFs are prescribed
+        (eq. 5.18/5.19) and not solved for.
+    solver : {"auto", "cg", "direct"}
+        See :func:`solve_spd`.
+
+    Notes
+    -----
+    Clamped boundary edges (eq. 5.19's Σ_c term) are handled through the load
+    ``g`` passed to :meth:`solve`.  A boundary edge without data is treated as
+    clamped with the discrete gradient as data, ``ξ = ∇_T w``, so its load
+    cancels B's one-sided term exactly: the "plain assembly", which still
+    converges but only like O(h^1/2) near the boundary (Walker §5.3.2).
+    """
+
+    def __init__(self, mesh: TriangleMesh, fixed_edges=None, solver="auto"):
+        self.mesh = mesh
+        self.solver = solver
+        self.phi = local_basis(mesh)
+        self.A = mass_matrix(mesh, self.phi)
+        self.B = jump_matrix(mesh)
+        if fixed_edges is None:
+            fixed_edges = np.zeros(mesh.n_edges, dtype=bool)
+        self.fixed = np.asarray(fixed_edges, dtype=bool)
+        self.free = ~self.fixed
+        self._A_ff = self.A[self.free][:, self.free] if self.fixed.any() else self.A
+        self._A_fs = self.A[self.free][:, self.fixed] if self.fixed.any() else None
+
+    def plain_boundary_load(self, w):
+        """Load that cancels B's one-sided term on boundary edges: ``g_e = l_e n·∇_T w``.
+
+        ``w`` : (#V, k). Returns (#E, k)."""
+        m = self.mesh
+        g = np.zeros((m.n_edges, w.shape[1]))
+        e = np.flatnonzero(m.boundary_edges)
+        if e.size:
+            g[e] = (self.B[e] @ w)
+        return g
+
+    def solve(self, w, load=None, fixed_values=None):
+        """Edge DOFs of the HHJ projection of ∇_Γ∇_Γ w.
+
+        Parameters
+        ----------
+        w : (#V, k) P1 vertex values of k functions.
+        load : (#E, k), optional
+            Boundary load g (eq. 5.19, Σ_c term); default: plain assembly.
+        fixed_values : (#E, k), optional
+            Values of the fixed (simply supported) DOFs; rows of free edges ignored.
+
+        Returns
+        -------
+        s : (#E, k) float64 edge DOFs σ^nn.
+        """
+        w = np.asarray(w, dtype=np.float64)
+        rhs = -(self.B @ w)
+        rhs += self.plain_boundary_load(w) if load is None else load
+        s = np.zeros_like(rhs)
+        if self.fixed.any():
+            if fixed_values is None:
+                raise ValueError("fixed (simply supported) edges need fixed_values")
+            s[self.fixed] = fixed_values[self.fixed]
+            rhs_f = rhs[self.free] - self._A_fs @ s[self.fixed]
+        else:
+            rhs_f = rhs
+        s[self.free] = solve_spd(self._A_ff, rhs_f, method=self.solver)
+        return s

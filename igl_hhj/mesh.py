@@ -1,0 +1,364 @@
+"""Mesh layer: a validated triangle mesh ``(V, F)`` and the quantities the
+finite-element layers need, computed once and vectorised over all faces.
+
+Conventions (libigl's, restated because every formula depends on them)
+----------------------------------------------------------------------
+* ``V`` is ``#V by 3`` float64, ``F`` is ``#F by 3`` int64; ``F`` is never
+  reordered: its orientation carries the sign of the normal.
+* Edge ``i`` of face ``T`` is the edge *opposite corner i*; it runs from
+  ``x_{i+1}`` to ``x_{i+2}`` (indices mod 3).  This is the corner/edge order of
+  ``igl.unique_edge_map``: ``EMAP[f + c*#F]`` is the unique edge opposite
+  corner ``c`` of face ``f``, so ``EMAP.reshape(3, #F).T`` is the face→edge map.
+* ``t_i`` = unit edge vector ``(x_{i+2} - x_{i+1}) / l_i``; ``ν_T`` = unit face
+  normal of ``(x1 - x0) × (x2 - x0)``; ``n_i = t_i × ν_T`` is the unit
+  *outward* conormal of edge ``i`` in the plane of ``T``;
+  ``∇λ_i = -l_i n_i / (2|T|)`` is the gradient of the P1 hat function of
+  corner ``i`` on ``T`` (Walker, paper 000, §4; design note hhj_lowest_order).
+
+Input checks raise ``TypeError`` (wrong kind of array) or ``ValueError`` (bad
+values), each naming the problem and the first offending index.  Unreferenced
+vertices are allowed; per-vertex outputs of the library give them NaN (see the
+individual functions).
+"""
+from __future__ import annotations
+
+from functools import cached_property
+
+import numpy as np
+
+__all__ = ["TriangleMesh", "validate_mesh", "as_mesh"]
+
+# A face whose area is below this fraction of its squared longest edge is
+# treated as degenerate (its smallest angle is below ~1e-12 rad).
+DEGENERATE_AREA_RTOL = 1e-12
+
+
+def _as_array(x, name):
+    if isinstance(x, np.ndarray):
+        return x
+    try:
+        return np.asarray(x)
+    except Exception as exc:  # ragged lists etc.
+        raise TypeError(f"{name} must be array-like, could not convert: {exc}") from None
+
+
+def validate_vertices(V, name="V"):
+    """Validate and coerce a vertex array.
+
+    Parameters
+    ----------
+    V : (#V, 3) array_like of real numbers (float32/float64/int accepted)
+
+    Returns
+    -------
+    V : (#V, 3) float64 C-contiguous numpy array (a copy if conversion was needed)
+    """
+    V = _as_array(V, name)
+    if V.dtype == object or not (np.issubdtype(V.dtype, np.floating)
+                                 or np.issubdtype(V.dtype, np.integer)):
+        raise TypeError(f"{name} must hold real numbers, got dtype {V.dtype}")
+    if V.ndim != 2 or V.shape[1] != 3:
+        raise ValueError(f"{name} must have shape (#V, 3), got shape {V.shape}")
+    if V.shape[0] == 0:
+        raise ValueError(f"{name} is empty: the mesh has no vertices")
+    V = np.ascontiguousarray(V, dtype=np.float64)
+    finite = np.isfinite(V).all(axis=1)
+    if not finite.all():
+        i = int(np.flatnonzero(~finite)[0])
+        raise ValueError(f"{name} has NaN or inf coordinates; first at vertex {i}: {V[i]}")
+    return V
+
+
+def validate_faces(F, nV, name="F"):
+    """Validate and coerce a face array against ``nV`` vertices.
+
+    Returns
+    -------
+    F : (#F, 3) int64 C-contiguous numpy array
+    """
+    F = _as_array(F, name)
+    if F.dtype == bool or not np.issubdtype(F.dtype, np.integer):
+        raise TypeError(f"{name} must hold integer vertex indices, got dtype {F.dtype}")
+    if F.ndim != 2 or F.shape[1] != 3:
+        raise ValueError(f"{name} must have shape (#F, 3) (triangles), got shape {F.shape}")
+    if F.shape[0] == 0:
+        raise ValueError(f"{name} is empty: the mesh has no faces")
+    F = np.ascontiguousarray(F, dtype=np.int64)
+    bad = (F < 0).any(axis=1)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"{name} has negative vertex indices; first at face {i}: {F[i]}")
+    bad = (F >= nV).any(axis=1)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"{name} has out-of-range vertex indices (#V = {nV}); "
+                         f"first at face {i}: {F[i]}")
+    bad = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"{name} has degenerate faces with a repeated vertex; "
+                         f"first at face {i}: {F[i]}")
+    return F
+
+
+class TriangleMesh:
+    """A validated, consistently oriented, edge-manifold triangle mesh.
+
+    Construction validates ``(V, F)`` completely (see module docstring);
+    every derived quantity is a lazily computed, cached, read-only array with
+    the element (face or edge) axis first.
+
+    Parameters
+    ----------
+    V : (#V, 3) array_like
+        Vertex positions (float32/float64 accepted; stored as float64).
+    F : (#F, 3) array_like
+        Triangle vertex indices (int32/int64 accepted; stored as int64).
+
+    Raises
+    ------
+    TypeError
+        Non-numeric ``V`` or non-integer ``F``.
+    ValueError
+        Wrong shapes, empty mesh, NaN/inf coordinates, negative or
+        out-of-range indices, repeated vertices in a face, zero-area faces,
+        non-manifold edges (more than two faces) or inconsistently oriented
+        neighbouring faces.
+    """
+
+    def __init__(self, V, F):
+        self.V = validate_vertices(V)
+        self.F = validate_faces(F, self.V.shape[0])
+        self._check_degenerate()
+        self._check_manifold_and_orientation()
+
+    # ------------------------------------------------------------------ sizes
+    @property
+    def n_vertices(self):
+        return self.V.shape[0]
+
+    @property
+    def n_faces(self):
+        return self.F.shape[0]
+
+    @property
+    def n_edges(self):
+        return self.edges.shape[0]
+
+    # ------------------------------------------------------------ topology
+    @cached_property
+    def _unique_edge_map(self):
+        import igl
+        E, uE, EMAP, uEC, uEE = igl.unique_edge_map(self.F)
+        return E, uE, EMAP, uEC, uEE
+
+    @cached_property
+    def edges(self):
+        """(#E, 2) int64: unique undirected edges (``uE`` of ``igl.unique_edge_map``)."""
+        return self._unique_edge_map[1]
+
+    @cached_property
+    def face_edges(self):
+        """(#F, 3) int64: ``face_edges[f, i]`` = unique edge opposite corner ``i`` of face ``f``."""
+        nF = self.n_faces
+        return np.ascontiguousarray(self._unique_edge_map[2].reshape(3, nF).T)
+
+    @cached_property
+    def edge_face_count(self):
+        """(#E,) int64: number of faces incident to each unique edge (1 = boundary)."""
+        return np.diff(self._unique_edge_map[3])
+
+    @cached_property
+    def face_edge_sign(self):
+        """(#F, 3) float64: +1 where the half-edge ``x_{i+1} → x_{i+2}`` of face f
+        runs in the direction of the unique edge ``edges[face_edges[f, i]]``, else -1."""
+        src = self.F[:, [1, 2, 0]]
+        return np.where(self.edges[self.face_edges, 0] == src, 1.0, -1.0)
+
+    @cached_property
+    def edge_faces(self):
+        """(#E, 2) int64: the faces on either side of each edge, -1 for none.
+
+        Column 0 holds the face in which the edge is positively oriented
+        (``face_edge_sign == +1``), column 1 the other one."""
+        nF = self.n_faces
+        ef = -np.ones((self.n_edges, 2), dtype=np.int64)
+        f = np.repeat(np.arange(nF), 3)
+        e = self.face_edges.ravel()
+        col = (self.face_edge_sign.ravel() < 0).astype(np.int64)
+        ef[e, col] = f
+        return ef
+
+    @cached_property
+    def edge_local_index(self):
+        """(#E, 2) int64: local index (0..2) of the edge inside each face of ``edge_faces``; -1 for none."""
+        li = -np.ones((self.n_edges, 2), dtype=np.int64)
+        e = self.face_edges.ravel()
+        col = (self.face_edge_sign.ravel() < 0).astype(np.int64)
+        li[e, col] = np.tile(np.arange(3), self.n_faces)
+        return li
+
+    @cached_property
+    def boundary_edges(self):
+        """(#E,) bool: edges with exactly one incident face."""
+        return self.edge_face_count == 1
+
+    @cached_property
+    def boundary_vertices(self):
+        """(#V,) bool: vertices on a boundary edge."""
+        mask = np.zeros(self.n_vertices, dtype=bool)
+        mask[self.edges[self.boundary_edges].ravel()] = True
+        return mask
+
+    @cached_property
+    def has_boundary(self):
+        return bool(self.boundary_edges.any())
+
+    @cached_property
+    def boundary_loops(self):
+        """list of (k,) int64 arrays: ordered boundary loops (``igl.boundary_loop_all``)."""
+        if not self.has_boundary:
+            return []
+        import igl
+        return [np.asarray(loop, dtype=np.int64) for loop in igl.boundary_loop_all(self.F)]
+
+    @cached_property
+    def referenced_vertices(self):
+        """(#V,) bool: vertices used by at least one face."""
+        mask = np.zeros(self.n_vertices, dtype=bool)
+        mask[self.F.ravel()] = True
+        return mask
+
+    # ------------------------------------------------------------ geometry
+    @cached_property
+    def _edge_vectors(self):
+        """(#F, 3, 3): vector of edge i of face f, ``x_{i+2} - x_{i+1}``."""
+        X = self.V[self.F]  # (#F, 3 corners, 3)
+        return X[:, [2, 0, 1]] - X[:, [1, 2, 0]]
+
+    @cached_property
+    def _cross(self):
+        X = self.V[self.F]
+        return np.cross(X[:, 1] - X[:, 0], X[:, 2] - X[:, 0])
+
+    @cached_property
+    def face_double_areas(self):
+        """(#F,) float64: twice the face areas, ``|(x1 - x0) × (x2 - x0)|``."""
+        return np.linalg.norm(self._cross, axis=1)
+
+    @cached_property
+    def face_areas(self):
+        """(#F,) float64: face areas |T|."""
+        return 0.5 * self.face_double_areas
+
+    @cached_property
+    def face_normals(self):
+        """(#F, 3) float64: unit face normals ν_T (right-hand rule on F's order)."""
+        return self._cross / self.face_double_areas[:, None]
+
+    @cached_property
+    def edge_lengths(self):
+        """(#F, 3) float64: ``l[f, i]`` = length of edge i (opposite corner i) of face f."""
+        return np.linalg.norm(self._edge_vectors, axis=2)
+
+    @cached_property
+    def unique_edge_lengths(self):
+        """(#E,) float64: length of each unique edge."""
+        d = self.V[self.edges[:, 1]] - self.V[self.edges[:, 0]]
+        return np.linalg.norm(d, axis=1)
+
+    @cached_property
+    def edge_tangents(self):
+        """(#F, 3, 3) float64: unit edge vectors ``t[f, i] = (x_{i+2} - x_{i+1}) / l_i``."""
+        return self._edge_vectors / self.edge_lengths[:, :, None]
+
+    @cached_property
+    def conormals(self):
+        """(#F, 3, 3) float64: unit outward conormals ``n[f, i] = t_i × ν_T`` (in the plane of T)."""
+        return np.cross(self.edge_tangents, self.face_normals[:, None, :])
+
+    @cached_property
+    def barycentric_gradients(self):
+        """(#F, 3, 3) float64: ``∇λ_i = -l_i n_i / (2|T|)``, gradient of corner i's hat function on f."""
+        return -(self.edge_lengths / self.face_double_areas[:, None])[:, :, None] * self.conormals
+
+    @cached_property
+    def mean_edge_length(self):
+        return float(self.unique_edge_lengths.mean())
+
+    @cached_property
+    def max_edge_length(self):
+        """The mesh size h = longest edge."""
+        return float(self.unique_edge_lengths.max())
+
+    @cached_property
+    def vertex_normals(self):
+        """(#V, 3) float64: area-weighted unit vertex normals (``igl.per_vertex_normals``).
+
+        Rows of unreferenced vertices are NaN."""
+        import igl
+        N = igl.per_vertex_normals(self.V, self.F,
+                                   igl.PerVertexNormalsWeightingType.PER_VERTEX_NORMALS_WEIGHTING_TYPE_AREA)
+        N = np.array(N, dtype=np.float64)
+        N[~self.referenced_vertices] = np.nan
+        return N
+
+    # ------------------------------------------------------------ checks
+    def _check_degenerate(self):
+        l2max = (self._edge_vectors ** 2).sum(axis=2).max(axis=1)
+        dbl = self.face_double_areas
+        bad = ~(dbl > DEGENERATE_AREA_RTOL * l2max)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise ValueError(
+                f"F has degenerate (zero-area) faces; first at face {i}: {self.F[i]} "
+                f"(area {0.5 * dbl[i]:.3g}, longest edge {np.sqrt(l2max[i]):.3g})")
+
+    def _check_manifold_and_orientation(self):
+        count = self.edge_face_count
+        bad = count > 2
+        if bad.any():
+            e = int(np.flatnonzero(bad)[0])
+            raise ValueError(
+                f"mesh has non-manifold edges (more than two incident faces); first is edge "
+                f"{e} between vertices {self.edges[e].tolist()} with {int(count[e])} faces")
+        # On a consistently oriented manifold every interior edge is traversed
+        # once in each direction.
+        pos = np.zeros(self.n_edges, dtype=np.int64)
+        np.add.at(pos, self.face_edges.ravel(), (self.face_edge_sign.ravel() > 0).astype(np.int64))
+        bad = (count == 2) & (pos != 1)
+        if bad.any():
+            e = int(np.flatnonzero(bad)[0])
+            f = np.flatnonzero((self.face_edges == e).any(axis=1))
+            raise ValueError(
+                f"mesh is not consistently oriented: faces {f.tolist()} traverse edge {e} "
+                f"(vertices {self.edges[e].tolist()}) in the same direction")
+
+
+def as_mesh(V, F=None):
+    """Return a :class:`TriangleMesh` for ``(V, F)``; a ``TriangleMesh`` passes through."""
+    if isinstance(V, TriangleMesh) and F is None:
+        return V
+    if F is None:
+        raise TypeError("F is required unless V is a TriangleMesh")
+    return TriangleMesh(V, F)
+
+
+def validate_mesh(V, F):
+    """Validate ``(V, F)`` and return them as float64 / int64 C-contiguous copies.
+
+    Raises the same errors as :class:`TriangleMesh`.
+    """
+    m = TriangleMesh(V, F)
+    return m.V, m.F
+
+
+def per_vertex_array(mesh, values, name, shape_tail=()):
+    """Validate an optional per-vertex data array of shape (#V, *shape_tail)."""
+    A = _as_array(values, name)
+    if A.dtype == object or not (np.issubdtype(A.dtype, np.floating) or np.issubdtype(A.dtype, np.integer)):
+        raise TypeError(f"{name} must hold real numbers, got dtype {A.dtype}")
+    want = (mesh.n_vertices,) + tuple(shape_tail)
+    if A.shape != want:
+        raise ValueError(f"{name} must have shape {want}, got {A.shape}")
+    return np.ascontiguousarray(A, dtype=np.float64)
