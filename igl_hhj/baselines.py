@@ -409,8 +409,8 @@ def pymeshlab_principal_curvature(V, F, method="quadric"):
 
     Returns
     -------
-    CurvatureEstimate, location "vertex"; d1 = pymeshlab's dir1 (paired with
-    its "Max Curvature"), d2 = dir2; rows re-sorted so that k1 ≥ k2 because
+    CurvatureEstimate, location "vertex"; d1 = pymeshlab's *dir2* (paired with
+    its "Max Curvature": measured, see the code), d2 = dir1; rows re-sorted so that k1 ≥ k2 because
     MeshLab's min/max are swapped for some methods (PyMeshLab#428; measured
     for "taubin").  ``bad`` = vertices with zero direction vectors and
     unreferenced vertices.
@@ -441,7 +441,10 @@ def pymeshlab_principal_curvature(V, F, method="quadric"):
                 np.asarray(m.vertex_curvature_principal_dir1_matrix(), dtype=np.float64),
                 np.asarray(m.vertex_curvature_principal_dir2_matrix(), dtype=np.float64))
 
-    kmax, d1, d2 = run("Max Curvature")
+    # Measured on ellipsoids: pymeshlab's dir2 is the direction of its
+    # "Max Curvature" for quadric fitting (dir1 is ⟂ to the exact κ1
+    # direction, median 89.5°), so dir2 is paired with kmax.
+    kmax, d2, d1 = run("Max Curvature")
     kmin, _, _ = run("Min Curvature")
     if len(kmax) != mesh.n_vertices:
         raise RuntimeError(f"pymeshlab changed the vertex count ({len(kmax)} != {mesh.n_vertices})")

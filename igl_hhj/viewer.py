@@ -7,7 +7,7 @@ polyscope is imported lazily inside every function.  Nothing here calls
 libegl-mesa0 libgl1-mesa-dri``).
 
 Colour ranges: for each quantity (κ1, κ2, H, K) the HHJ mesh and the libigl
-mesh share one range, the 2nd–98th percentile of both value sets together
+mesh share one range, the 5th–95th percentile (by default) of both value sets together
 (symmetric about 0 for K and for signed data that changes sign), so the two
 pictures are directly comparable.
 """
@@ -66,7 +66,7 @@ def curvature_fields(V, F, *, solver="auto", radius=5):
 
 
 def register_comparison(V, F, *, name="mesh", fields=None, enabled="k1", offset=None,
-                        directions=True, cmap="coolwarm"):
+                        directions=True, cmap="coolwarm", percentile=5.0):
     """Register two copies of the mesh: HHJ face curvatures and libigl vertex curvatures.
 
     Parameters
@@ -78,6 +78,7 @@ def register_comparison(V, F, *, name="mesh", fields=None, enabled="k1", offset=
     offset : (3,) translation of the libigl copy; default 1.2 × the bounding
         box width along x.
     directions : bool, also add the principal directions (face / vertex vectors).
+    percentile : float, colour range = [p, 100-p] percentiles (see :func:`shared_range`).
 
     Returns
     -------
@@ -98,7 +99,7 @@ def register_comparison(V, F, *, name="mesh", fields=None, enabled="k1", offset=
     ranges = {}
     for q in QUANTITIES:
         a, b = getattr(hhj, q), getattr(igl_, q)
-        ranges[q] = shared_range(a, b)
+        ranges[q] = shared_range(a, b, percentile=percentile)
         m_h.add_scalar_quantity(f"{_LABEL[q]} (HHJ, faces)", np.nan_to_num(a), defined_on="faces",
                                 vminmax=ranges[q], cmap=cmap, enabled=(q == enabled))
         m_i.add_scalar_quantity(f"{_LABEL[q]} (libigl, vertices)", np.nan_to_num(b), defined_on="vertices",
@@ -117,7 +118,7 @@ def register_comparison(V, F, *, name="mesh", fields=None, enabled="k1", offset=
 
 
 def screenshot(V, F, path, *, quantity="k1", fields=None, backend="openGL3_egl", size=(1200, 600),
-               name="mesh"):
+               name="mesh", percentile=5.0):
     """Render HHJ (left) and libigl (right) side by side for one quantity and save a PNG.
 
     Parameters
@@ -127,6 +128,7 @@ def screenshot(V, F, path, *, quantity="k1", fields=None, backend="openGL3_egl",
     fields : optional precomputed (hhj, igl) from :func:`curvature_fields`.
     backend : polyscope backend; "openGL3_egl" renders without a display.
     size : window size in pixels.
+    percentile : float, colour range percentile (see :func:`shared_range`).
 
     Returns
     -------
@@ -138,7 +140,8 @@ def screenshot(V, F, path, *, quantity="k1", fields=None, backend="openGL3_egl",
     ps.remove_all_structures()
     ps.set_window_size(int(size[0]), int(size[1]))
     ps.set_ground_plane_mode("none")
-    reg = register_comparison(V, F, name=name, fields=fields, enabled=quantity, directions=False)
+    reg = register_comparison(V, F, name=name, fields=fields, enabled=quantity, directions=False,
+                              percentile=percentile)
     ps.reset_camera_to_home_view()
     ps.screenshot(str(path), transparent_bg=False)
     return reg["ranges"][quantity]

@@ -209,3 +209,30 @@ def test_heine_coarse_meshes_on_surface_and_outward(label):
 def test_heine_sphere_is_unit_sphere():
     s = heine_surfaces()["5.1d"]
     assert isinstance(s, Sphere) and s.R == 1.0
+
+
+# ----------------------------------------------------------------- benchmark smoke test
+def test_compare_estimators_quick_run(tmp_path):
+    pytest.importorskip("tqdm")
+    pytest.importorskip("matplotlib")
+    from igl_hhj.benchmarks.compare_estimators import run
+    res = run(tmp_path, quick=True, real=False, speed_sizes=[320],
+              estimators=["hhj_vertex", "hhj_face", "libigl_quadric", "heine"],
+              cases=["ellipsoid (5.1c)", "Heine (5.1a), jittered 30%"])
+    report = (tmp_path / "compare_estimators.md").read_text()
+    assert "Heine's P1 Weingarten map: paper vs this run" in report
+    assert (tmp_path / "compare_estimators.json").exists()
+    assert any(p.name.startswith("conv_") for p in tmp_path.iterdir())
+    acc = res["accuracy"]["ellipsoid (5.1c)"]["runs"]
+    assert set(acc) == {"hhj_vertex", "hhj_face", "libigl_quadric", "heine"}
+    for runs in acc.values():
+        assert all(np.isfinite(r["H"]) for r in runs)
+    # the same measurement as the convergence test, through the benchmark's error code:
+    heine_H = [r["H"] for r in res["accuracy"]["Heine (5.1a), jittered 30%"]["runs"]["heine"]]
+    hhj_H = [r["H"] for r in res["accuracy"]["Heine (5.1a), jittered 30%"]["runs"]["hhj_vertex"]]
+    assert hhj_H[-1] < 0.5 * heine_H[-1]
+    assert res["speed"][0]["runs"]["libigl_quadric"]["time"] > 0
+    with pytest.raises(ValueError, match="unknown estimators"):
+        run(tmp_path, quick=True, estimators=["nope"])
+    with pytest.raises(ValueError, match="unknown cases"):
+        run(tmp_path, quick=True, cases=["nope"], do_speed=False, real=False)

@@ -18,7 +18,7 @@ import numpy as np
 
 from .exact import Ellipsoid, ImplicitSurface, Sphere
 
-__all__ = ["HeineA", "HeineB", "heine_surfaces", "heine_coarse"]
+__all__ = ["HeineA", "HeineB", "heine_surfaces", "heine_coarse", "heine_sequence"]
 
 
 class HeineA(ImplicitSurface):
@@ -118,3 +118,43 @@ def heine_coarse(label, subdivisions=1, amount=0.25, seed=0):
     elif label == "5.1c":
         V = surface.project(V * surface.axes)
     return V, np.asarray(F, dtype=np.int64), surface
+
+
+def heine_sequence(label, n_levels, pre_refine=1, subdivisions=1, amount=0.25, jitter=0.0, seed=0):
+    """Non-uniform mesh sequence of a Heine surface, built on the unit sphere and mapped.
+
+    The perturbed icosphere of :func:`heine_coarse` is refined on the unit
+    sphere (``igl.upsample`` + radial projection); with ``jitter > 0`` every
+    level is then moved tangentially by up to ``jitter`` × the local edge
+    length (seeded, re-projected onto the sphere), so no parallelogram
+    structure survives refinement.  Finally the vertices are mapped onto the
+    surface: exactly by the shear for (5.1a)/(5.1b), by scaling + Newton
+    projection for (5.1c), identity for (5.1d).  (Newton projection of jittered
+    points straight onto (5.1a)/(5.1b) can leave the tubular neighbourhood on
+    coarse meshes; the sphere map cannot.)
+
+    Returns
+    -------
+    levels : list of (V, F), coarse to fine; surface : ImplicitSurface
+    """
+    from .meshing import jitter_tangentially, mesh_sequence
+    surfaces = heine_surfaces()
+    if label not in surfaces:
+        raise ValueError(f"unknown Heine surface {label!r}; use one of {sorted(surfaces)}")
+    surface = surfaces[label]
+    from .meshing import icosphere
+    sph = Sphere(1.0)
+    V, F = icosphere(subdivisions)
+    V = jitter_tangentially(V, F, sph, amount, seed)
+    out = []
+    for k, (Vk, Fk) in enumerate(mesh_sequence(V, F, sph, n_levels, pre_refine)):
+        if jitter > 0:
+            Vk = jitter_tangentially(Vk, Fk, sph, jitter, seed + 1 + k)
+        if label == "5.1a":
+            Vk = HeineA.from_sphere(Vk)
+        elif label == "5.1b":
+            Vk = HeineB.from_sphere(Vk)
+        elif label == "5.1c":
+            Vk = surface.project(Vk * surface.axes)
+        out.append((Vk, np.asarray(Fk, dtype=np.int64)))
+    return out, surface
