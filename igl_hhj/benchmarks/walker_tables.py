@@ -1,0 +1,341 @@
+"""Reproduce Walker's convergence tables (paper 000, §6, Tables 1–5, m = 1).
+
+For each of the paper's four surfaces — the clamped saddle (§6.1), the
+simply supported wavy dumbbell (§6.2), the torus (§6.3) and the genus-3
+surface (§6.4) — this builds a non-uniform, non-symmetric mesh sequence with
+Walker's triangle counts (448, 608, ≈1904, ≈2808 × 4^k), computes the HHJ
+shape operator S_h (:func:`igl_hhj.shape_operator`, with I_h of the exact
+boundary data), and prints Walker's table layout — k, #faces, h, L2 error of
+ν, L2 and L∞ errors of S_h, L2 errors of κ^a = tr S_h and
+κ^g = det(S_h + ν⊗ν), EOC in parentheses — beside the paper's published
+m = 1 numbers (copied below as data), plus the condition numbers of the HHJ
+mass matrix A and of D⁻¹A (Walker Table 1; extreme eigenvalues by
+``scipy.sparse.linalg.eigsh``, the smallest by shift-invert on one sparse LU).
+
+Run::
+
+    python -m igl_hhj.benchmarks.walker_tables [--levels 4] [--out benchmark-results]
+
+``--levels 5`` adds k = 4 (≈ 3 M unknowns on the genus-3 surface).  Outputs
+``walker_tables.md`` and ``walker_tables.png`` in ``--out``.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import time
+
+import numpy as np
+
+from ..convergence import eoc, shape_operator_errors
+from ..curvature import shape_operator
+from ..hhj import mass_matrix
+from ..mesh import as_mesh
+from ..surfaces.boundary_data import walker_boundary_data
+from ..surfaces.dumbbell import WalkerDumbbell, dumbbell_sequence, saddle_sequence
+from ..surfaces.exact import WalkerGenus3, WalkerSaddle, WalkerTorus
+from ..surfaces.implicit_meshing import genus3_coarse, implicit_sequence, torus_mc_coarse
+
+__all__ = ["PAPER_TABLES", "PAPER_COND", "SURFACES", "surface_levels", "condition_numbers",
+           "run", "format_table", "main"]
+
+KEYS = ("nu", "S", "S_inf", "kappa_a", "kappa_g")
+HEAD = ("‖ν‖L2", "‖S‖L2", "‖S‖L∞", "‖κa‖L2", "‖κg‖L2")
+
+# --------------------------------------------------------------------------------------------
+# PAPER DATA — S. W. Walker, "Approximating the shape operator with the surface HHJ element"
+# (shared/papers/000_*.txt), m = 1 rows of Tables 2 (saddle), 3 (dumbbell), 4 (torus),
+# 5 (genus-3): per k the errors (ν L2, ∇ν L2, ∇ν L∞, κ^a L2, κ^g L2) and the published EOCs.
+# Copied by hand from the paper; NOT computed by this project.
+# --------------------------------------------------------------------------------------------
+PAPER_TABLES = {
+    "saddle": {"faces0": 448, "boundary": "clamped (I_h ν)", "table": 2, "rows": [
+        ((1.09e-01, 1.04e00, 1.13e00, 5.94e-01, 2.48e00), (1.02, 0.84, 1.77, 0.89, 1.02)),
+        ((5.44e-02, 5.48e-01, 4.45e-01, 3.09e-01, 1.26e00), (1.01, 0.92, 1.35, 0.94, 0.97)),
+        ((2.72e-02, 2.81e-01, 2.31e-01, 1.57e-01, 6.44e-01), (1.00, 0.96, 0.95, 0.97, 0.97)),
+        ((1.36e-02, 1.42e-01, 1.27e-01, 7.97e-02, 3.26e-01), (1.00, 0.98, 0.86, 0.98, 0.98)),
+        ((6.79e-03, 7.15e-02, 6.65e-02, 4.02e-02, 1.64e-01), (1.00, 0.99, 0.94, 0.99, 0.99)),
+    ]},
+    "dumbbell": {"faces0": 608, "boundary": "simply supported (I_h ∇ν)", "table": 3, "rows": [
+        ((1.65e-01, 5.62e-01, 4.37e-01, 3.67e-01, 4.05e-01), (1.00, 0.95, 1.01, 1.01, 1.01)),
+        ((8.25e-02, 2.86e-01, 2.13e-01, 1.84e-01, 2.05e-01), (1.00, 0.97, 1.04, 1.00, 0.98)),
+        ((4.12e-02, 1.44e-01, 1.00e-01, 9.22e-02, 1.04e-01), (1.00, 0.99, 1.09, 1.00, 0.98)),
+        ((2.06e-02, 7.23e-02, 4.79e-02, 4.63e-02, 5.22e-02), (1.00, 0.99, 1.06, 1.00, 0.99)),
+        ((1.03e-02, 3.62e-02, 2.33e-02, 2.32e-02, 2.62e-02), (1.00, 1.00, 1.04, 1.00, 1.00)),
+    ]},
+    "torus": {"faces0": 1904, "boundary": "closed", "table": 4, "rows": [
+        ((3.16e-01, 2.03e00, 6.05e-01, 1.05e00, 2.55e00), (None,) * 5),
+        ((1.59e-01, 1.07e00, 3.80e-01, 5.58e-01, 1.41e00), (1.00, 0.92, 0.67, 0.91, 0.85)),
+        ((7.93e-02, 5.54e-01, 1.81e-01, 2.97e-01, 7.54e-01), (1.00, 0.96, 1.07, 0.91, 0.91)),
+        ((3.97e-02, 2.81e-01, 1.01e-01, 1.56e-01, 3.90e-01), (1.00, 0.98, 0.84, 0.94, 0.95)),
+        ((1.98e-02, 1.42e-01, 5.25e-02, 7.98e-02, 1.99e-01), (1.00, 0.99, 0.94, 0.96, 0.97)),
+    ]},
+    "genus3": {"faces0": 2808, "boundary": "closed", "table": 5, "rows": [
+        ((5.77e-01, 4.44e00, 2.06e00, 1.88e00, 9.14e00), (None,) * 5),
+        ((2.93e-01, 2.39e00, 1.04e00, 1.15e00, 4.79e00), (0.98, 0.89, 0.99, 0.72, 0.93)),
+        ((1.47e-01, 1.24e00, 5.95e-01, 6.46e-01, 2.62e00), (0.99, 0.95, 0.80, 0.83, 0.87)),
+        ((7.36e-02, 6.34e-01, 2.95e-01, 3.44e-01, 1.39e00), (1.00, 0.97, 1.01, 0.91, 0.91)),
+        ((3.68e-02, 3.20e-01, 1.42e-01, 1.78e-01, 7.12e-01), (1.00, 0.99, 1.06, 0.95, 0.97)),
+        ((1.84e-02, 1.61e-01, 7.00e-02, 9.03e-02, 3.58e-01), (1.00, 0.99, 1.02, 0.98, 0.99)),
+    ]},
+}
+# Walker Table 1 (m = 1): 2-norm condition number of A^m and, in parentheses, of (D^m)^-1 A^m
+# with D^m the mass-lumped A^m; k = 0..4.  Copied from the paper; basis-dependent (see notes).
+PAPER_COND = {
+    "saddle": ((7.61e02, 4.89e02), (9.65e02, 6.93e02), (1.11e03, 8.93e02), (1.18e03, 1.05e03), (1.26e03, 1.15e03)),
+    "dumbbell": ((3.90e02, 1.80e02), (4.87e02, 2.41e02), (5.69e02, 3.04e02), (6.39e02, 3.62e02), (6.95e02, 4.05e02)),
+    "torus": ((2.89e02, 2.15e01), (4.55e02, 3.80e01), (5.88e02, 5.42e01), (7.00e02, 6.74e01), (7.72e02, 7.57e01)),
+    "genus3": ((4.39e02, 3.13e01), (7.10e02, 6.23e01), (8.75e02, 1.01e02), (9.64e02, 1.31e02), (1.00e03, 1.53e02)),
+}
+
+SURFACES = ("saddle", "dumbbell", "torus", "genus3")
+# boundary treatment per case; "<surface>_plain" = the same meshes without boundary data
+BOUNDARY = {"saddle": "clamped", "dumbbell": "simply_supported", "torus": "plain", "genus3": "plain",
+            "saddle_plain": "plain", "dumbbell_plain": "plain"}
+
+
+def surface_levels(name, n_levels, seed=0):
+    """Exact surface and Walker-style mesh sequence [(V_k, F_k)], k = 0..n_levels-1.
+
+    ``name`` is one of :data:`SURFACES` (a ``_plain`` suffix is accepted)."""
+    base = name[:-6] if name.endswith("_plain") else name
+    if base == "saddle":
+        return WalkerSaddle(), saddle_sequence(n_levels, seed=seed)
+    if base == "dumbbell":
+        return WalkerDumbbell(), dumbbell_sequence(n_levels, seed=seed)
+    if base == "torus":
+        s = WalkerTorus()
+        return s, implicit_sequence(*torus_mc_coarse(seed=seed), s, n_levels)
+    if base == "genus3":
+        s = WalkerGenus3()
+        return s, implicit_sequence(*genus3_coarse(seed=seed), s, n_levels)
+    raise ValueError(f"unknown surface {name!r}; use one of {SURFACES} (optionally with '_plain')")
+
+
+def condition_numbers(A, tol=1e-6):
+    """Spectral condition numbers of an SPD sparse matrix A and of D⁻¹A, D = diag(A).
+
+    κ(A) = λ_max/λ_min from ``eigsh`` (λ_max: Lanczos; λ_min: shift-invert
+    about 0 through one ``splu`` of A).  D⁻¹A is similar to the SPD matrix
+    D^-1/2 A D^-1/2, so κ(D⁻¹A) is its λ_max/λ_min, the number that governs
+    Jacobi-preconditioned CG; its shift-invert reuses the same LU
+    ((D^-1/2 A D^-1/2)⁻¹ = D^1/2 A⁻¹ D^1/2).
+
+    Returns
+    -------
+    (cond_A, cond_DA) : floats
+    """
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+    A = sp.csc_matrix(A)
+    n = A.shape[0]
+    d = A.diagonal()
+    if np.any(d <= 0):
+        raise ValueError("A must be SPD (positive diagonal)")
+    s = 1.0 / np.sqrt(d)
+    Ah = sp.csc_matrix(sp.diags(s) @ A @ sp.diags(s))
+    lu = spla.splu(A)
+    inv_A = spla.LinearOperator((n, n), matvec=lambda x: lu.solve(np.asarray(x, dtype=np.float64).ravel()))
+    r = np.sqrt(d)
+    inv_Ah = spla.LinearOperator((n, n), matvec=lambda x: r * lu.solve(r * np.asarray(x, dtype=np.float64).ravel()))
+    out = []
+    for M, inv in ((A, inv_A), (Ah, inv_Ah)):
+        lmax = spla.eigsh(M, k=1, which="LA", tol=tol, return_eigenvectors=False)[0]
+        lmin = spla.eigsh(M, k=1, sigma=0.0, OPinv=inv, which="LM", tol=tol, return_eigenvectors=False)[0]
+        out.append(float(lmax / lmin))
+    return tuple(out)
+
+
+def _centroid_linf(V, F, S, surface):
+    """Diagnostic: max over faces of |I_h ∇ν(centroid) - S_h| (Frobenius)."""
+    Sex = surface.shape_operator(V)[F].mean(axis=1)
+    return float(np.sqrt(((Sex - S) ** 2).sum(axis=(1, 2))).max())
+
+
+def run(surfaces=SURFACES, levels=4, out=None, cond=True, cond_levels=None, controls=True, plot=True,
+        progress=True, seed=0):
+    """Compute the tables.
+
+    Parameters
+    ----------
+    surfaces : iterable of names from :data:`SURFACES`.
+    levels : int, number of refinement levels k = 0..levels-1.
+    out : str or None, output folder for ``walker_tables.md`` / ``.png`` (None: no files).
+    cond : bool, compute the condition numbers (Table 1).
+    cond_levels : int or None, compute them only for k < cond_levels.
+    controls : bool, also run the saddle/dumbbell without boundary data (plain assembly).
+    plot : bool, write the log-log error plot (needs ``out``).
+    progress : bool, tqdm progress bar.
+    seed : int, mesh seed.
+
+    Returns
+    -------
+    dict name → list of per-level dicts (keys of
+    :func:`igl_hhj.convergence.shape_operator_errors` plus ``S_inf_centroid``,
+    ``cond_A``, ``cond_DA``, ``seconds``, ``min_angle``).
+    """
+    surfaces = list(surfaces)
+    for name in surfaces:
+        if name not in SURFACES:
+            raise ValueError(f"unknown surface {name!r}; use one of {SURFACES}")
+    if int(levels) < 1:
+        raise ValueError(f"levels must be at least 1, got {levels}")
+    cases = list(surfaces)
+    if controls:
+        cases += [f"{n}_plain" for n in surfaces if BOUNDARY[n] != "plain"]
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+        bar = tqdm(total=len(cases) * levels, desc="walker tables", unit="level")
+    meshes = {}
+    results = {}
+    for name in cases:
+        base = name[:-6] if name.endswith("_plain") else name
+        if base not in meshes:
+            meshes[base] = surface_levels(base, levels, seed)
+        surface, seq = meshes[base]
+        rows = []
+        for k, (V, F) in enumerate(seq):
+            t0 = time.perf_counter()
+            kw = walker_boundary_data(V, F, surface, BOUNDARY[name])
+            S = shape_operator(V, F, **kw)
+            e = shape_operator_errors(V, F, S, surface)
+            e["seconds"] = time.perf_counter() - t0
+            e["S_inf_centroid"] = _centroid_linf(V, F, S, surface)
+            e["min_angle"] = _min_angle(V, F)
+            e["cond_A"] = e["cond_DA"] = float("nan")
+            if cond and not name.endswith("_plain") and (cond_levels is None or k < cond_levels):
+                mesh = as_mesh(V, F)
+                A = mass_matrix(mesh)
+                if BOUNDARY[name] == "simply_supported":      # the matrix actually inverted: free DOFs
+                    free = ~mesh.boundary_edges
+                    A = A[free][:, free]
+                e["cond_A"], e["cond_DA"] = condition_numbers(A)
+            rows.append(e)
+            if bar is not None:
+                bar.set_postfix_str(f"{name} k={k} #F={len(F)}")
+                bar.update(1)
+        results[name] = rows
+    if bar is not None:
+        bar.close()
+    if out is not None:
+        os.makedirs(out, exist_ok=True)
+        with open(os.path.join(out, "walker_tables.md"), "w", encoding="utf-8") as fh:
+            fh.write(format_report(results))
+        if plot:
+            plot_errors(results, os.path.join(out, "walker_tables.png"))
+    return results
+
+
+def _min_angle(V, F):
+    X = np.asarray(V)[np.asarray(F)]
+    ang = []
+    for i in range(3):  # 3 corners, vectorised over faces
+        u = X[:, (i + 1) % 3] - X[:, i]
+        v = X[:, (i + 2) % 3] - X[:, i]
+        c = np.einsum("ij,ij->i", u, v) / (np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1))
+        ang.append(np.degrees(np.arccos(np.clip(c, -1, 1))))
+    return float(np.min(ang))
+
+
+def _fmt(x):
+    return "—" if x is None or not np.isfinite(x) else f"{x:.2e}"
+
+
+def _fmt_eoc(x):
+    return "" if x is None or not np.isfinite(x) else f" ({x:.2f})"
+
+
+def format_table(name, rows):
+    """Markdown table of one case in Walker's layout, the paper's m = 1 numbers beside ours."""
+    base = name[:-6] if name.endswith("_plain") else name
+    paper = PAPER_TABLES[base]
+    hs = [r["h"] for r in rows]
+    rates = {key: np.concatenate([[np.nan], eoc([r[key] for r in rows], hs)]) if len(rows) > 1
+             else np.array([np.nan]) for key in KEYS + ("S_inf_centroid",)}
+    lines = []
+    bnd = "no boundary data (plain assembly)" if name.endswith("_plain") else paper["boundary"]
+    title = f"### {base} — Walker Table {paper['table']}, boundary: {bnd}"
+    lines += [title, ""]
+    lines.append("| k | #F | h | " + " | ".join(HEAD) + " | ‖S‖L∞ centroid | min ∠ |")
+    lines.append("|---|---|---|" + "---|" * (len(HEAD) + 2))
+    for k, r in enumerate(rows):
+        cells = [f"{_fmt(r[key])}{_fmt_eoc(rates[key][k])}" for key in KEYS]
+        cells.append(f"{_fmt(r['S_inf_centroid'])}{_fmt_eoc(rates['S_inf_centroid'][k])}")
+        lines.append(f"| {k} | {r['faces']} | {r['h']:.3g} | " + " | ".join(cells) + f" | {r['min_angle']:.1f}° |")
+        if k < len(paper["rows"]) and not name.endswith("_plain"):
+            pe, pr = paper["rows"][k]
+            pcells = [f"{_fmt(v)}{_fmt_eoc(q)}" for v, q in zip(pe, pr)]
+            lines.append(f"| paper {k} | {paper['faces0'] * 4 ** k} | | " + " | ".join(pcells) + " | | |")
+    lines.append("")
+    if any(np.isfinite(r["cond_A"]) for r in rows):
+        lines += [f"Condition numbers (Walker Table 1, {base}): ours κ(A) (κ(D⁻¹A), D = diag A) | paper (D = lumped A)",
+                  "", "| k | ours κ(A) | ours κ(D⁻¹A) | paper κ(A) | paper κ(D⁻¹A) |", "|---|---|---|---|---|"]
+        for k, r in enumerate(rows):
+            pc = PAPER_COND[base][k] if k < len(PAPER_COND[base]) else (None, None)
+            lines.append(f"| {k} | {_fmt(r['cond_A'])} | {_fmt(r['cond_DA'])} | {_fmt(pc[0])} | {_fmt(pc[1])} |")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def format_report(results):
+    parts = ["# Walker's convergence tables (paper 000, §6, m = 1): igl_hhj vs the paper", "",
+             "Rows `k` are ours, rows `paper k` are Walker's published numbers (copied as data). "
+             "EOC in parentheses (log(e_k/e_k+1)/log(h_k/h_k+1)). Errors: I_h of the exact field vs the "
+             "face-wise S_h (igl_hhj.convergence.shape_operator_errors); ‖S‖L∞ = max over face corners; "
+             "'‖S‖L∞ centroid' = max over face centroids (diagnostic, not in the paper).", ""]
+    for name, rows in results.items():
+        parts.append(format_table(name, rows))
+    return "\n".join(parts) + "\n"
+
+
+def plot_errors(results, path):
+    """Log-log plot of the L2 errors against h, one panel per surface, slope-1 guides,
+    Walker's published errors drawn at our h of the same k (hollow markers)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    names = [n for n in results if not n.endswith("_plain")]
+    fig, axes = plt.subplots(1, len(names), figsize=(3.6 * len(names), 3.4), squeeze=False)
+    styles = {"S": ("C0", "o", "‖S‖"), "kappa_a": ("C1", "s", "‖κa‖"), "kappa_g": ("C2", "^", "‖κg‖"),
+              "nu": ("C3", "v", "‖ν‖")}
+    for ax, name in zip(axes[0], names):
+        rows = results[name]
+        h = np.array([r["h"] for r in rows])
+        idx = {"nu": 0, "S": 1, "kappa_a": 3, "kappa_g": 4}
+        for key, (c, m, lab) in styles.items():
+            e = np.array([r[key] for r in rows])
+            ax.loglog(h, e, color=c, marker=m, label=lab)
+            pe = [PAPER_TABLES[name]["rows"][k][0][idx[key]] for k in range(min(len(rows), len(PAPER_TABLES[name]["rows"])))]
+            ax.loglog(h[:len(pe)], pe, color=c, marker=m, mfc="none", ls=":", alpha=0.7)
+        top = max(r["kappa_g"] for r in rows)
+        ax.loglog(h, 1.3 * top * h / h[0], "k--", lw=0.8, label="slope 1")
+        ax.set_title(f"{name} (#F₀={rows[0]['faces']})")
+        ax.set_xlabel("h")
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0][0].set_ylabel("L2 error (solid: igl_hhj, dotted: Walker)")
+    axes[0][0].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--levels", type=int, default=4, help="refinement levels k = 0..levels-1 (5 adds k = 4)")
+    p.add_argument("--surfaces", nargs="+", default=list(SURFACES), choices=SURFACES)
+    p.add_argument("--out", default="benchmark-results")
+    p.add_argument("--no-cond", action="store_true", help="skip the condition numbers")
+    p.add_argument("--cond-levels", type=int, default=None, help="condition numbers only for k < this")
+    p.add_argument("--no-controls", action="store_true", help="skip the no-boundary-data controls")
+    p.add_argument("--seed", type=int, default=0)
+    a = p.parse_args(argv)
+    t0 = time.perf_counter()
+    res = run(a.surfaces, a.levels, a.out, cond=not a.no_cond, cond_levels=a.cond_levels,
+              controls=not a.no_controls, seed=a.seed)
+    print(format_report(res))
+    print(f"total {time.perf_counter() - t0:.1f} s; wrote {os.path.join(a.out, 'walker_tables.md')}")
+
+
+if __name__ == "__main__":
+    main()
