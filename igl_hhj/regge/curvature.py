@@ -130,6 +130,12 @@ def _element_terms(gh, space, quad_degree):
     pts, w = triangle_rule(quad_degree)
     phi = space.basis(pts)
     g, dg, ddg = gh.reference_values(pts, derivatives=2)
+    gv = gh.reference_values(REF_VERTICES, derivatives=0)
+    for G in (g, gv):
+        bad = ((G[..., 0, 0] <= 0) | (G[..., 0, 0] * G[..., 1, 1] - G[..., 0, 1] ** 2 <= 0)).any(axis=1)
+        if bad.any():
+            raise ValueError("the Regge metric g_h is not positive definite on face "
+                             f"{int(np.flatnonzero(bad)[0])} (refine the mesh or raise the degree)")
     K = metric_gauss_curvature(g, dg, ddg)
     vol = np.sqrt(g[..., 0, 0] * g[..., 1, 1] - g[..., 0, 1] ** 2)
     load = np.einsum("q,fq,qa->fa", w, K * vol, phi)

@@ -298,6 +298,13 @@ def _call_metric(metric, X):
         raise ValueError(f"metric must map (N, 2) points to (N, 2, 2) tensors, got shape {G.shape}")
     if not np.isfinite(G).all():
         raise ValueError("metric returned NaN or inf values")
+    if not np.allclose(G, np.swapaxes(G, 1, 2), rtol=1e-12, atol=0):
+        i = int(np.flatnonzero(np.abs(G[:, 0, 1] - G[:, 1, 0]) > 1e-12 * np.abs(G).max())[0])
+        raise ValueError(f"metric is not symmetric; first at point {X[i]}")
+    bad = (G[:, 0, 0] <= 0) | (G[:, 0, 0] * G[:, 1, 1] - G[:, 0, 1] * G[:, 1, 0] <= 0)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"metric is not positive definite; first at point {X[i]}: {G[i].tolist()}")
     return G
 
 
