@@ -319,3 +319,16 @@ def test_bad_input_raises_clear_errors():
         triangle_rule(-1)
     with pytest.raises(TypeError, match="integer"):
         gauss_legendre(2.0)
+
+
+def test_benchmark_runs_on_tiny_sizes(tmp_path):
+    pytest.importorskip("matplotlib")
+    from igl_hhj.benchmarks import regge_convergence as bench
+    res = bench.run(levels=(1, 2, 3), ks=(1,), controls=True, densitized=True, control_levels=(1, 2))
+    assert set(res["runs"]) == {"k=1, p=1", "k=1, p=1, densitized", "k=1, p=2", "k=0, p=1"}
+    md = bench.markdown(res)
+    assert "k=1, p=1" in md and "Reference (regge.md)" in md
+    bench.plot(res, tmp_path / "r.png")
+    assert (tmp_path / "r.png").stat().st_size > 1000
+    bench.main(["--out", str(tmp_path / "o"), "--levels", "1", "2", "--no-plot"])
+    assert (tmp_path / "o" / "regge.md").exists()
