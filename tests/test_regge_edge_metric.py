@@ -159,3 +159,17 @@ def test_unreferenced_vertices_are_nan():
     V, F = _sphere(0)
     K = gauss_curvature(np.vstack([V, [[5.0, 5, 5]]]), F)
     assert np.isnan(K[-1]) and np.isfinite(K[:-1]).all()
+
+
+@pytest.mark.parametrize("name", ["bunny.off", "fertility.off", "camelhead.off"])
+def test_gauss_bonnet_on_real_meshes(name):
+    import os
+    path = os.path.join("/work/shared/data/meshes", name)
+    if not os.path.exists(path):
+        pytest.skip(f"{path} not available")
+    V, F = igl.read_triangle_mesh(path)
+    K = gauss_curvature(V, F, boundary="geodesic")
+    nE = igl.edges(F).shape[0]
+    chi = len(np.unique(F)) - nE + len(F)
+    assert np.nansum(igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_FULL) @ np.nan_to_num(K)) == \
+        pytest.approx(2 * np.pi * chi, abs=1e-9)
