@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from .elements import (REF_EDGE_NORMALS, REF_EDGE_TANGENTS, REF_VERTICES, LagrangeSpace,
-                       PlanarTriangulation, ReggeMetric, _call_metric, _call_scalar,
+                       ReggeMetric, _call_metric, _call_scalar,
                        _check_int, monomials)
 from .quadrature import gauss_legendre, triangle_rule
 

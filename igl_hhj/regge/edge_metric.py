@@ -76,7 +76,7 @@ def _face_l_sq(l_sq, F, FE, nE, rtol=1e-10):
     if L.dtype == object or not (np.issubdtype(L.dtype, np.floating) or np.issubdtype(L.dtype, np.integer)):
         raise TypeError(f"l_sq must hold real numbers, got dtype {L.dtype}")
     L = np.asarray(L, dtype=np.float64)
-    if L.shape == (nE,) and not (L.shape == (F.shape[0], 3)):
+    if L.shape == (nE,):
         Lf = L[FE]
     elif L.shape == (F.shape[0], 3):
         Lf = L

@@ -473,7 +473,11 @@ def interpolate(P, F, metric, k, quad_degree=None):
     ``∫_T g_h : ρ dx = ∫_T ḡ : ρ dx`` for all ``ρ ∈ P^{k-1}(T; S)``,
 
     with Gauss rules exact to degree ``quad_degree`` (default ``2k + 16``, i.e.
-    exact moments for polynomial metrics of degree ≤ k + 16).
+    exact moments for polynomial metrics of degree ≤ k + 16).  The local
+    ``3(k+1)(k+2)/2`` systems share one reference matrix (the conditions are
+    invariant under the affine pull-back ``ĝ = Jᵀ ḡ J``); to keep round-off
+    out of the curvature (which amplifies metric errors by ~1/h²) the moments
+    of ``ĝ - ĝ(centroid)`` are solved for and the constant added back.
 
     Parameters
     ----------
