@@ -400,7 +400,7 @@ def pymeshlab_principal_curvature(V, F, method="quadric"):
     """MeshLab's per-vertex principal curvatures (optional peer; ``pip install pymeshlab``).
 
     Runs ``compute_curvature_principal_directions_per_vertex`` twice (the
-    filter stores only one scalar: "Max Curvature", then "Min Curvature"),
+    filter stores only one scalar: "Min Curvature", then "Max Curvature"),
     with ``autoclean=False`` so vertex indices are kept.
 
     Parameters
@@ -409,10 +409,11 @@ def pymeshlab_principal_curvature(V, F, method="quadric"):
 
     Returns
     -------
-    CurvatureEstimate, location "vertex"; d1 = pymeshlab's *dir2* (paired with
-    its "Max Curvature": measured, see the code), d2 = dir1; rows re-sorted so that k1 ≥ k2 because
-    MeshLab's min/max are swapped for some methods (PyMeshLab#428; measured
-    for "taubin").  ``bad`` = vertices with zero direction vectors and
+    CurvatureEstimate, location "vertex"; d1 = pymeshlab's dir1 paired with the
+    value it names "Min Curvature", d2 = dir2 with "Max Curvature", then rows
+    re-sorted so that k1 ≥ k2: MeshLab's min/max names are swapped
+    (PyMeshLab#428; measured: "Min" > "Max" at every vertex for "quadric", at
+    a third of them for "taubin").  ``bad`` = vertices with zero direction vectors and
     unreferenced vertices.
 
     Notes
@@ -441,11 +442,12 @@ def pymeshlab_principal_curvature(V, F, method="quadric"):
                 np.asarray(m.vertex_curvature_principal_dir1_matrix(), dtype=np.float64),
                 np.asarray(m.vertex_curvature_principal_dir2_matrix(), dtype=np.float64))
 
-    # Measured on ellipsoids: pymeshlab's dir2 is the direction of its
-    # "Max Curvature" for quadric fitting (dir1 is ⟂ to the exact κ1
-    # direction, median 89.5°), so dir2 is paired with kmax.
-    kmax, d2, d1 = run("Max Curvature")
-    kmin, _, _ = run("Min Curvature")
+    # Measured on ellipsoids (quadric fitting): the value pymeshlab names "Min
+    # Curvature" is the larger one at every vertex and dir1 is its direction
+    # (median angle to the exact κ1 direction 0.2°; 13 % of vertices are ~90°
+    # off), so dir1 is paired with the "Min Curvature" value, then sorted.
+    kmax, d1, d2 = run("Min Curvature")
+    kmin, _, _ = run("Max Curvature")
     if len(kmax) != mesh.n_vertices:
         raise RuntimeError(f"pymeshlab changed the vertex count ({len(kmax)} != {mesh.n_vertices})")
     n1 = np.linalg.norm(d1, axis=1)
