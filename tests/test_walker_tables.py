@@ -44,10 +44,16 @@ def _sequence(name):
 
 
 def _errors(name, kind=None):
+    from igl_hhj.benchmarks.walker_tables import linf_entry_centroid
     surface, seq = _sequence(name)
     kind = KIND[name] if kind is None else kind
-    return [shape_operator_errors(V, F, shape_operator(V, F, **walker_boundary_data(V, F, surface, kind)), surface)
-            for V, F in seq]
+    rows = []
+    for V, F in seq:
+        S = shape_operator(V, F, **walker_boundary_data(V, F, surface, kind))
+        e = shape_operator_errors(V, F, S, surface)
+        e["S_inf_centroid"] = linf_entry_centroid(V, F, S, surface)
+        rows.append(e)
+    return rows
 
 
 def _min_angle(V, F):
@@ -74,9 +80,9 @@ def test_walker_table_rates_and_paper_errors(name):
     for k, r in enumerate(rows):
         n_paper = paper["faces0"] * 4 ** k
         assert abs(r["faces"] - n_paper) <= 0.05 * n_paper, (name, k, r["faces"], n_paper)
-        for j, key in enumerate(("nu", "S", "S_inf", "kappa_a", "kappa_g")):
-            if key == "S_inf":
-                continue        # different L∞ sampling than the paper (see the benchmark notes)
+        for j, key in enumerate(("nu", "S", "S_inf_centroid", "kappa_a", "kappa_g")):
+            # L∞: the paper's column is matched by the max |entry| at face centroids; the
+            # project's S_inf (Frobenius at the corners) is 3-7x larger (reported, not asserted)
             ratio = r[key] / paper["rows"][k][0][j]
             assert 1 / 3 <= ratio <= 3, f"{name} k={k} {key}: ours/paper = {ratio:.2f}"
     # the ν error is O(h) with constant ≈ the paper's

@@ -301,6 +301,7 @@ def plot_errors(results, path):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker  # noqa: F401
     names = [n for n in results if not n.endswith("_plain")]
     fig, axes = plt.subplots(1, len(names), figsize=(3.6 * len(names), 3.4), squeeze=False)
     styles = {"S": ("C0", "o", "‖S‖"), "kappa_a": ("C1", "s", "‖κa‖"), "kappa_g": ("C2", "^", "‖κg‖"),
@@ -318,6 +319,7 @@ def plot_errors(results, path):
         ax.loglog(h, 1.3 * top * h / h[0], "k--", lw=0.8, label="slope 1")
         ax.set_title(f"{name} (#F₀={rows[0]['faces']})")
         ax.set_xlabel("h")
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.grid(True, which="both", alpha=0.3)
     axes[0][0].set_ylabel("L2 error (solid: igl_hhj, dotted: Walker)")
     axes[0][0].legend(fontsize=7)
