@@ -104,7 +104,7 @@ def stiffness_matrix(mesh):
     K : (#V, #V) scipy.sparse.csr_matrix
     """
     import igl
-    return sp.csr_matrix(-igl.cotmatrix(mesh.V, mesh.F))
+    return _pad(-igl.cotmatrix(mesh.V, mesh.F), mesh.n_vertices)
 
 
 def mass_matrix(mesh, kind="full"):
@@ -124,7 +124,17 @@ def mass_matrix(mesh, kind="full"):
              "voronoi": igl.MASSMATRIX_TYPE_VORONOI}
     if kind not in types:
         raise ValueError(f"mass must be one of {MASS_TYPES}, got {kind!r}")
-    return sp.csr_matrix(igl.massmatrix(mesh.V, mesh.F, types[kind]))
+    return _pad(igl.massmatrix(mesh.V, mesh.F, types[kind]), mesh.n_vertices)
+
+
+def _pad(A, n):
+    """csr copy of A padded with zero rows/columns to n × n (libigl sizes some
+    matrices by ``max(F) + 1``, dropping trailing unreferenced vertices)."""
+    A = sp.csr_matrix(A)
+    if A.shape != (n, n):
+        A = sp.csr_matrix((A.data, A.indices, np.concatenate(
+            [A.indptr, np.full(n - A.shape[0], A.indptr[-1])])), shape=(n, n))
+    return A
 
 
 def boundary_mass_matrix(mesh):

@@ -552,11 +552,11 @@ def biharmonic_errors(V, F, u1, u2, problem):
     dict with ``h`` (longest edge), ``n_vertices``, ``u1_L2``, ``u1_H1``,
     ``u1_H1_grad``, ``u2_L2``, ``u1_L2_rel`` (``‖e‖ / ‖I_h u‖``), ``u2_L2_rel``.
     """
-    import igl
     from ..mesh import as_mesh
     mesh = as_mesh(V, F)
-    K = -igl.cotmatrix(mesh.V, mesh.F)
-    M = igl.massmatrix(mesh.V, mesh.F, igl.MASSMATRIX_TYPE_FULL)
+    from ..biharmonic import mass_matrix, stiffness_matrix
+    K = stiffness_matrix(mesh)
+    M = mass_matrix(mesh, "full")
     ok = mesh.referenced_vertices
     U = np.where(ok, problem.u(mesh.V), 0.0)
     U2 = np.where(ok, problem.u2(mesh.V), 0.0)
