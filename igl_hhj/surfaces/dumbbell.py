@@ -13,8 +13,10 @@ coarse mesh comes from the ``triangle`` package (boundary vertices on the
 curved boundary, no Steiner points on it), its interior vertices are
 perturbed; the refined meshes are uniform refinements (``igl.upsample``) of
 this straight coarse mesh mapped by a blended curved-element map (Walker:
-"a Lenoir type map") that puts every boundary vertex on the closest point of
-∂U, before lifting by χ.
+"a Lenoir type map") that puts every boundary vertex on ∂U (at the curve
+parameter interpolated between the coarse edge's end points), before lifting
+by χ.  ``refine_planar`` (closest-point projection of the new boundary
+midpoints only) is kept for comparison.
 """
 from __future__ import annotations
 
