@@ -1,9 +1,21 @@
 """igl_hhj: provably convergent finite-element curvature for libigl triangle meshes.
 
-The core is Walker's surface Hellan–Herrmann–Johnson (HHJ) shape operator
-(:func:`shape_operator`), with a drop-in replacement for
-``igl.principal_curvature`` (:func:`principal_curvature`).
+Core (imported eagerly, needs only libigl, numpy, scipy):
+
+* :func:`shape_operator` — Walker's surface-HHJ shape operator S_h, one tensor per face;
+* :func:`surface_hessian` — HHJ projection of the surface Hessian of a P1 function;
+* :func:`principal_curvature` — drop-in replacement for ``igl.principal_curvature``;
+* :func:`face_principal_curvature`, :func:`face_mean_curvature`, :func:`face_gaussian_curvature`.
+
+Submodules (imported on first use): :mod:`igl_hhj.regge` (Regge metrics and
+lifted distributional Gauss curvature), :mod:`igl_hhj.biharmonic` (mixed P1
+biharmonic solver, also as :func:`biharmonic_solve`), :mod:`igl_hhj.baselines`
+(libigl, Heine and pymeshlab estimators behind one interface),
+:mod:`igl_hhj.viewer` (polyscope), :mod:`igl_hhj.surfaces` (exact test
+surfaces and mesh sequences), :mod:`igl_hhj.benchmarks`.
 """
+import importlib
+
 from .curvature import (
     face_gaussian_curvature,
     face_mean_curvature,
@@ -17,8 +29,26 @@ from .mesh import TriangleMesh, validate_mesh
 
 __version__ = "0.1.0"
 
+_LAZY_MODULES = {"regge", "biharmonic", "baselines", "viewer", "surfaces", "benchmarks",
+                 "hhj", "mesh", "convergence", "cli"}
+_LAZY_ATTRS = {"biharmonic_solve": "biharmonic", "BiharmonicSolver": "biharmonic"}
+
 __all__ = [
     "shape_operator", "surface_hessian", "principal_curvature",
     "face_principal_curvature", "face_mean_curvature", "face_gaussian_curvature",
     "principal_from_shape_operator", "TriangleMesh", "validate_mesh",
+    "biharmonic_solve", "BiharmonicSolver",
 ]
+
+
+def __getattr__(name):
+    """Import submodules (and their headline functions) on first use."""
+    if name in _LAZY_MODULES:
+        return importlib.import_module(f".{name}", __name__)
+    if name in _LAZY_ATTRS:
+        return getattr(importlib.import_module(f".{_LAZY_ATTRS[name]}", __name__), name)
+    raise AttributeError(f"module 'igl_hhj' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | _LAZY_MODULES | set(_LAZY_ATTRS))
