@@ -62,6 +62,10 @@ PAPER = {
                       "observed": "(§5.3, no experiment)"},
 }
 
+EXACT_AREA = {"hemisphere": 2 * np.pi, "cap": 2 * np.pi * (1 - np.cos(np.pi / 4)),
+              "lantern m~n": 2 * np.pi, "lantern m~n^2": 2 * np.pi, "lantern n~m^2": 2 * np.pi,
+              "closed sphere": 4 * np.pi}
+
 KEYS = [("u1_L2", "‖u1-u‖L2"), ("u1_H1", "|u1-I_h u|H1"), ("u1_H1_grad", "‖∇(u1-u)‖L2"),
         ("u2_L2", "‖u2+Δu‖L2")]
 
@@ -103,17 +107,18 @@ def convergence_study(problem, meshes, **solve_kw):
 def _fmt_table(name, rows):
     hs = [r["h"] for r in rows]
     lines = [f"### {name}", "",
-             "| #V | h | " + " | ".join(f"{lab} | EOC" for _, lab in KEYS) + " |",
-             "|---|---|" + "---|---|" * len(KEYS)]
+             "| #V | h | area | " + " | ".join(f"{lab} | EOC" for _, lab in KEYS) + " |",
+             "|---|---|---|" + "---|---|" * len(KEYS)]
     rates = {k: np.concatenate([[np.nan], eoc([r[k] for r in rows], hs)]) for k, _ in KEYS}
     for i, r in enumerate(rows):
-        cells = [f"{r['n_vertices']}", f"{r['h']:.4f}"]
+        cells = [f"{r['n_vertices']}", f"{r['h']:.4f}", f"{r['area']:.4f}"]
         for k, _ in KEYS:
             e = rates[k][i]
             cells += [f"{r[k]:.3e}", "" if np.isnan(e) else f"{e:.2f}"]
         lines.append("| " + " | ".join(cells) + " |")
     p = PAPER[name]
-    lines += ["", f"paper 001 proven rates: u1 L2 {p['u1_L2']}, u1 H1 {p['u1_H1']}, u2 L2 {p['u2_L2']}; "
+    lines += ["", f"exact area: {EXACT_AREA[name]:.4f}; "
+                  f"paper 001 proven rates: u1 L2 {p['u1_L2']}, u1 H1 {p['u1_H1']}, u2 L2 {p['u2_L2']}; "
                   f"observed: {p['observed']}"]
     return "\n".join(lines)
 
@@ -122,6 +127,7 @@ def _plot(results, path):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
     names = list(results)
     fig, axes = plt.subplots(2, (len(names) + 1) // 2, figsize=(4.2 * ((len(names) + 1) // 2), 7.5))
     for ax, name in zip(axes.ravel(), names):
@@ -134,6 +140,7 @@ def _plot(results, path):
         ax.set_title(name, fontsize=10)
         ax.set_xlabel("h (longest edge)")
         ax.invert_xaxis()
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.grid(True, which="both", lw=0.3)
     for ax in axes.ravel()[len(names):]:
         ax.axis("off")
