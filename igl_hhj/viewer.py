@@ -21,6 +21,7 @@ __all__ = ["init", "shared_range", "curvature_fields", "register_comparison", "s
            "QUANTITIES"]
 
 QUANTITIES = ("k1", "k2", "H", "K")
+_SHOT = 0
 _LABEL = {"k1": "kappa1", "k2": "kappa2", "H": "mean H", "K": "Gauss K"}
 
 
@@ -96,14 +97,21 @@ def register_comparison(V, F, *, name="mesh", fields=None, enabled="k1", offset=
     offset = np.asarray(offset, dtype=np.float64).reshape(3)
     m_h = ps.register_surface_mesh(f"{name} HHJ", mesh.V, mesh.F)
     m_i = ps.register_surface_mesh(f"{name} libigl", mesh.V + offset, mesh.F)
-    ranges = {}
+    ranges, added = {}, {}
     for q in QUANTITIES:
         a, b = getattr(hhj, q), getattr(igl_, q)
         ranges[q] = shared_range(a, b, percentile=percentile)
-        m_h.add_scalar_quantity(f"{_LABEL[q]} (HHJ, faces)", np.nan_to_num(a), defined_on="faces",
-                                vminmax=ranges[q], cmap=cmap, enabled=(q == enabled))
-        m_i.add_scalar_quantity(f"{_LABEL[q]} (libigl, vertices)", np.nan_to_num(b), defined_on="vertices",
-                                vminmax=ranges[q], cmap=cmap, enabled=(q == enabled))
+        added[q] = (
+            m_h.add_scalar_quantity(f"{_LABEL[q]} (HHJ, faces)", np.nan_to_num(a), defined_on="faces",
+                                    vminmax=ranges[q], cmap=cmap, enabled=(q == enabled)),
+            m_i.add_scalar_quantity(f"{_LABEL[q]} (libigl, vertices)", np.nan_to_num(b), defined_on="vertices",
+                                    vminmax=ranges[q], cmap=cmap, enabled=(q == enabled)))
+    if enabled is not None:
+        # polyscope remembers "enabled" per structure/quantity name across
+        # re-registration; enable the wanted one last so it wins.
+        for qty in added[enabled]:
+            if qty is not None and hasattr(qty, "set_enabled"):
+                qty.set_enabled(True)
     if directions:
         for k, d in (("d1", "PD1"), ("d2", "PD2")):
             if getattr(hhj, k) is not None:
@@ -140,7 +148,12 @@ def screenshot(V, F, path, *, quantity="k1", fields=None, backend="openGL3_egl",
     ps.remove_all_structures()
     ps.set_window_size(int(size[0]), int(size[1]))
     ps.set_ground_plane_mode("none")
-    reg = register_comparison(V, F, name=name, fields=fields, enabled=quantity, directions=False,
+    global _SHOT
+    _SHOT += 1
+    # A fresh structure name per picture: re-registering a *different* mesh under
+    # the same names leaves the first screenshot without its scalar quantity
+    # (polyscope keeps per-name state; measured with the EGL backend).
+    reg = register_comparison(V, F, name=f"{name} {_SHOT}", fields=fields, enabled=quantity, directions=False,
                               percentile=percentile)
     ps.reset_camera_to_home_view()
     ps.screenshot(str(path), transparent_bg=False)
