@@ -394,6 +394,23 @@ def write_report(res, outdir):
          "`bad` = points without a value (NaN / flagged).", ""]
     if res.get("summary_plot"):
         L += [f"![relative L2 error of H]({res['summary_plot']})", ""]
+    L += ["## Headline: relative L2 error of H and RMS κ1-direction angle on the finest mesh", "",
+          "| case | best H (estimator) | hhj_vertex H | libigl_quadric H | libigl_cotan H | heine H | "
+          "best dir ° (estimator) | hhj_vertex dir ° |", "|---|---|---|---|---|---|---|---|"]
+    for cname, c in res["accuracy"].items():
+        if not c["levels"]:
+            continue
+        last = {n: runs[-1] for n, runs in c["runs"].items() if "H" in runs[-1]}
+        if not last:
+            continue
+        bh = min(last, key=lambda n: last[n]["H"])
+        dirs = {n: r["dir"] for n, r in last.items() if np.isfinite(r.get("dir", np.nan))}
+        bd = min(dirs, key=dirs.get) if dirs else None
+        get = lambda n, k="H": _fmt(last[n][k]) if n in last and k in last[n] else "–"  # noqa: E731
+        L.append(f"| {cname} | {_fmt(last[bh]['H'])} ({bh}) | {get('hhj_vertex')} | {get('libigl_quadric')} | "
+                 f"{get('libigl_cotan')} | {get('heine')} | "
+                 f"{(_fmt(dirs[bd]) + ' (' + bd + ')') if bd else '–'} | {get('hhj_vertex', 'dir')} |")
+    L += [""]
     L += ["## Accuracy: finest mesh and rates", ""]
     for cname, c in res["accuracy"].items():
         L += [f"### {cname}", "", c["description"] + ("  (norms over interior vertices)" if c["open"] else ""), ""]
@@ -465,7 +482,9 @@ def write_report(res, outdir):
     # speed
     L += ["## Speed and memory (refined ellipsoid, one run each, same process)", "",
           f"Ratios are time / time of `{REFERENCE}` on the same mesh in this run. Peak memory = peak RSS "
-          "increase during the call (Linux VmHWM), includes libigl's C++ allocations.", ""]
+          "increase during the call (Linux VmHWM, reset before each call), includes libigl's C++ allocations "
+          "but not memory the process already holds from earlier calls (hence 0 MB for small libigl runs): "
+          "a lower bound.", ""]
     if res["speed"]:
         names = list(res["speed"][0]["runs"])
         L += ["| faces | " + " | ".join(names) + " |", "|---|" + "---|" * len(names)]
