@@ -39,6 +39,9 @@ __all__ = [
 
 # solver="auto" factorises directly up to this many unknowns, above it uses PCG.
 AUTO_DIRECT_MAX = 50000
+# ... and gives PCG this many iterations before falling back to the direct solver
+# (well-shaped meshes need 50–250; meshes full of slivers can need thousands).
+AUTO_CG_MAXITER = 600
 
 
 class SolverDidNotConverge(RuntimeError):
@@ -220,14 +223,15 @@ def solve_spd(A, R, *, method="auto", rtol=1e-10, maxiter=None, preconditioner=N
         ``preconditioner`` (a sparse SPD approximation of A⁻¹, e.g.
         :func:`face_schwarz_preconditioner`) or, without one, Jacobi.
         "direct": sparse LU (``scipy.sparse.linalg.splu``).
-        "auto": direct up to 50 000 unknowns; above, CG, falling back to the
-        direct solver if CG has not converged after ``maxiter`` iterations.
+        "auto": direct up to ``AUTO_DIRECT_MAX`` (50 000) unknowns; above,
+        PCG, falling back to the direct solver if it has not converged after
+        ``maxiter`` (default ``AUTO_CG_MAXITER`` = 600) iterations.
     rtol : float
         CG stops when ``‖r_j‖ ≤ rtol ‖R_j‖`` for every column j.  The default
         1e-10 leaves a solver error far below every discretisation error in
         the convergence tables (tests compare CG with the direct solve).
     maxiter : int, optional
-        CG iteration cap (default 2000).
+        CG iteration cap (default 2000 for "cg", 600 for "auto").
 
     Raises
     ------
@@ -244,6 +248,8 @@ def solve_spd(A, R, *, method="auto", rtol=1e-10, maxiter=None, preconditioner=N
     if method == "auto" and n <= AUTO_DIRECT_MAX:
         method = "direct"
     X = None
+    if method == "auto" and maxiter is None:
+        maxiter = AUTO_CG_MAXITER
     if method in ("cg", "auto"):
         try:
             X = _block_pcg(sp.csr_matrix(A), R, rtol, maxiter, preconditioner)
@@ -256,42 +262,56 @@ def solve_spd(A, R, *, method="auto", rtol=1e-10, maxiter=None, preconditioner=N
 
 
 def _block_pcg(A, R, rtol, maxiter, M=None):
+    """Preconditioned CG on the columns of R at once (independent recurrences,
+    shared sparse products).  Buffers are reused: at 10⁵–10⁶ unknowns each
+    iteration is memory-bound."""
     n, k = R.shape
     if maxiter is None:
         maxiter = 2000
     if M is None:
-        dinv = 1.0 / A.diagonal()
+        dinv = (1.0 / A.diagonal())[:, None]
         def apply(r):  # noqa: E306
-            return dinv[:, None] * r
+            return dinv * r
     else:
         def apply(r):  # noqa: E306
             return M @ r
+    tmp = np.empty((n, k))
+    ones = np.ones(n)
+
+    def coldot(a, b):  # column-wise dot products; `ones @` is a BLAS gemv, 50x faster than .sum(0)
+        np.multiply(a, b, out=tmp)
+        return ones @ tmp
+
     X = np.zeros((n, k))
     r = R.copy()
-    bnorm = np.linalg.norm(R, axis=0)
-    tol = rtol * bnorm
-    active = np.linalg.norm(r, axis=0) > tol
+    bb = coldot(R, R)
+    tol2 = (rtol ** 2) * bb
+    rr = bb
+    active = rr > tol2
     if not active.any():
         return X
     z = apply(r)
     p = z.copy()
-    rz = np.einsum("ij,ij->j", r, z)
+    rz = coldot(r, z)
     for _ in range(maxiter):
         q = A @ p
-        pq = np.einsum("ij,ij->j", p, q)
+        pq = coldot(p, q)
         alpha = np.where(active, rz / np.where(active, pq, 1.0), 0.0)
-        X += alpha * p
-        r -= alpha * q
-        rnorm = np.linalg.norm(r, axis=0)
-        active = rnorm > tol
+        np.multiply(p, alpha, out=tmp)
+        X += tmp
+        np.multiply(q, alpha, out=tmp)
+        r -= tmp
+        rr = coldot(r, r)
+        active = rr > tol2
         if not active.any():
             return X
         z = apply(r)
-        rz_new = np.einsum("ij,ij->j", r, z)
+        rz_new = coldot(r, z)
         beta = np.where(active, rz_new / np.where(active, rz, 1.0), 0.0)
         rz = rz_new
-        p = z + beta * p
-    worst = float(np.max(rnorm / np.where(bnorm > 0, bnorm, 1.0)))
+        p *= beta
+        p += z
+    worst = float(np.max(np.sqrt(rr / np.where(bb > 0, bb, 1.0))))
     raise SolverDidNotConverge(
         f"preconditioned CG did not converge in {maxiter} iterations "
         f"(relative residual {worst:.2e} > {rtol:.1e}); the mesh may contain "
