@@ -48,6 +48,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from .curvature import check_principal_curvature_args, vertex_principal_curvature
 from .mesh import as_mesh
 
 __all__ = [
@@ -113,15 +114,6 @@ def _ordered(name, location, k1, k2, H, K, d1, d2, bad):
     return CurvatureEstimate(location, k1, k2, H, K, d1, d2, bad, name)
 
 
-def _check_radius(radius, useKring):
-    if isinstance(radius, (bool, np.bool_)) or not isinstance(radius, (int, np.integer)):
-        raise TypeError(f"radius must be an int (as in igl.principal_curvature), got {type(radius).__name__}")
-    if not radius > 0:
-        raise ValueError(f"radius must be positive, got {radius}")
-    if not isinstance(useKring, (bool, np.bool_)):
-        raise TypeError(f"useKring must be a bool (as in igl.principal_curvature), got {type(useKring).__name__}")
-
-
 # --------------------------------------------------------------------------- HHJ
 def hhj_vertex(V, F, **kwargs):
     """HHJ drop-in at the vertices (:func:`igl_hhj.curvature.principal_curvature`).
@@ -174,7 +166,7 @@ def libigl_quadric(V, F, radius=5, useKring=True):
     outward-oriented sphere.
     """
     import igl
-    _check_radius(radius, useKring)
+    check_principal_curvature_args(radius, useKring)
     mesh = as_mesh(V, F)
     PD1, PD2, PV1, PV2, bad = igl.principal_curvature(mesh.V, mesh.F, int(radius), bool(useKring))
     bad = np.concatenate([np.asarray(bad, dtype=np.int64), np.flatnonzero(~mesh.referenced_vertices)])
@@ -370,21 +362,14 @@ def heine(V, F):
     are the eigenpairs of ``sym(Π_h)`` restricted to the tangent plane of the
     projected normal ``nu``.
     """
-    from .curvature import principal_from_shape_operator
     mesh = as_mesh(V, F)
     Pi, nu, _ = heine_weingarten_map(mesh.V, mesh.F)
     tr = np.trace(Pi, axis1=1, axis2=2)
     H = 0.5 * tr
     K = 0.5 * (tr ** 2 - np.einsum("ijk,ikj->i", Pi, Pi))
-    ref = mesh.referenced_vertices
-    n = mesh.n_vertices
-    d1 = np.full((n, 3), np.nan)
-    d2 = np.full((n, 3), np.nan)
-    k1 = np.full(n, np.nan)
-    k2 = np.full(n, np.nan)
     S = 0.5 * (Pi + np.swapaxes(Pi, 1, 2))
-    d1[ref], d2[ref], k1[ref], k2[ref] = principal_from_shape_operator(S[ref], nu[ref])
-    return _ordered("heine", "vertex", k1, k2, H, K, d1, d2, np.flatnonzero(~ref))
+    d1, d2, k1, k2 = vertex_principal_curvature(mesh, S, nu)
+    return _ordered("heine", "vertex", k1, k2, H, K, d1, d2, np.flatnonzero(~mesh.referenced_vertices))
 
 
 # --------------------------------------------------------------------------- pymeshlab

@@ -15,7 +15,8 @@ from .mesh import TriangleMesh, as_mesh, per_vertex_array
 __all__ = [
     "shape_operator", "surface_hessian", "principal_curvature",
     "face_principal_curvature", "face_mean_curvature", "face_gaussian_curvature",
-    "principal_from_shape_operator", "vertex_shape_operator",
+    "principal_from_shape_operator", "vertex_shape_operator", "vertex_principal_curvature",
+    "check_principal_curvature_args",
 ]
 
 
@@ -272,6 +273,37 @@ def face_gaussian_curvature(V, F, **boundary):
     return np.linalg.det(S + nu[:, :, None] * nu[:, None, :])
 
 
+def check_principal_curvature_args(radius, useKring):
+    """Validate the ``radius`` / ``useKring`` arguments of ``igl.principal_curvature``'s signature."""
+    if isinstance(radius, (bool, np.bool_)) or not isinstance(radius, (int, np.integer)):
+        raise TypeError(f"radius must be an int (as in igl.principal_curvature), got {type(radius).__name__}")
+    if not radius > 0:
+        raise ValueError(f"radius must be positive, got {radius}")
+    if not isinstance(useKring, (bool, np.bool_)):
+        raise TypeError(f"useKring must be a bool (as in igl.principal_curvature), got {type(useKring).__name__}")
+
+
+def vertex_principal_curvature(mesh, Sv, N):
+    """Principal directions/curvatures of per-vertex tensors, NaN at unreferenced vertices.
+
+    Parameters
+    ----------
+    Sv : (#V, 3, 3) per-vertex tensors (tangential to N), N : (#V, 3) unit normals.
+
+    Returns
+    -------
+    PD1, PD2 : (#V, 3), PV1, PV2 : (#V,) as :func:`principal_from_shape_operator`.
+    """
+    ref = mesh.referenced_vertices
+    nV = mesh.n_vertices
+    PD1 = np.full((nV, 3), np.nan)
+    PD2 = np.full((nV, 3), np.nan)
+    PV1 = np.full(nV, np.nan)
+    PV2 = np.full(nV, np.nan)
+    PD1[ref], PD2[ref], PV1[ref], PV2[ref] = principal_from_shape_operator(Sv[ref], N[ref])
+    return PD1, PD2, PV1, PV2
+
+
 def vertex_shape_operator(mesh, S):
     """Recover per-vertex tensors from face tensors.
 
@@ -337,21 +369,11 @@ def principal_curvature(V, F, radius=5, useKring=True, *, boundary_normals=None,
 
     Positive curvature on a sphere with outward normals, as libigl.
     """
-    if isinstance(radius, (bool, np.bool_)) or not isinstance(radius, (int, np.integer)):
-        raise TypeError(f"radius must be an int (as in igl.principal_curvature), got {type(radius).__name__}")
-    if not isinstance(useKring, (bool, np.bool_)):
-        raise TypeError(f"useKring must be a bool (as in igl.principal_curvature), got {type(useKring).__name__}")
+    check_principal_curvature_args(radius, useKring)
     mesh = as_mesh(V, F)
     S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver)
     Sv, N = vertex_shape_operator(mesh, S)
-    ref = mesh.referenced_vertices
-    nV = mesh.n_vertices
-    PD1 = np.full((nV, 3), np.nan)
-    PD2 = np.full((nV, 3), np.nan)
-    PV1 = np.full(nV, np.nan)
-    PV2 = np.full(nV, np.nan)
-    d1, d2, k1, k2 = principal_from_shape_operator(Sv[ref], N[ref])
-    PD1[ref], PD2[ref], PV1[ref], PV2[ref] = d1, d2, k1, k2
-    bad = np.flatnonzero(~ref).tolist()
+    PD1, PD2, PV1, PV2 = vertex_principal_curvature(mesh, Sv, N)
+    bad = np.flatnonzero(~mesh.referenced_vertices).tolist()
     return (np.ascontiguousarray(PD1), np.ascontiguousarray(PD2),
             np.ascontiguousarray(PV1), np.ascontiguousarray(PV2), bad)

@@ -98,6 +98,8 @@ def test_bad_arguments():
     V, F = igl.icosahedron()
     with pytest.raises(TypeError, match="radius must be an int"):
         igl_hhj.principal_curvature(V, F, 2.5)
+    with pytest.raises(ValueError, match="radius must be positive"):
+        igl_hhj.principal_curvature(V, F, 0)
     with pytest.raises(TypeError, match="useKring must be a bool"):
         igl_hhj.principal_curvature(V, F, 5, "yes")
     with pytest.raises(ValueError, match="out-of-range"):
