@@ -147,7 +147,7 @@ def _plot(results, path):
     axes.ravel()[0].legend(fontsize=7)
     fig.suptitle("Mixed P1 biharmonic (Stein et al., §6): errors vs h", fontsize=11)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=85)
     plt.close(fig)
 
 
