@@ -263,6 +263,9 @@ class BiharmonicSolver:
         Stiffness (eq. 6.3), mass of (6.1) and consistent load mass (eq. 6.5).
     interior : (#V,) bool
         Vertices carrying a ``u1`` unknown (referenced, not on the boundary).
+    method : str
+        Linear-algebra path in use: "saddle", "schur" (PCG), "lumped" (exact
+        sparse Schur complement), or the bc name for "navier"/"closed".
     last_iterations : int or None
         PCG iterations of the last solve (``None`` for direct solves).
 
@@ -282,7 +285,7 @@ class BiharmonicSolver:
         self.bc = _check_choice(bc, "bc", BOUNDARY_CONDITIONS)
         self.mass = _check_choice(mass, "mass", MASS_TYPES)
         self.solver = _check_choice(solver, "solver", SOLVERS)
-        if not (isinstance(rtol, (float, int)) and 0 < rtol < 1):
+        if isinstance(rtol, bool) or not (isinstance(rtol, (float, int)) and 0 < rtol < 1):
             raise ValueError(f"rtol must be a number in (0, 1), got {rtol!r}")
         self.rtol = float(rtol)
         mesh = self.mesh
@@ -297,6 +300,7 @@ class BiharmonicSolver:
         self._I = np.flatnonzero(self.interior)
         self._A = np.flatnonzero(self.active)
         self._B = np.flatnonzero(self.active & mesh.boundary_vertices)
+        self.method = self.bc
         if self.bc == "clamped":
             self._setup_clamped()
         elif self.bc == "navier":
@@ -342,19 +346,19 @@ class BiharmonicSolver:
         I, A = self._I, self._A
         self._Bmat = self.K[I][:, A].tocsr()           # K_IA: rows ξ ∈ S_h,0, cols u2 ∈ S_h
         M_AA = self.M[A][:, A].tocsr()
-        self._method = self.solver
+        self.method = self.solver
         if self.mass != "full":
             if self.solver == "saddle":
                 raise ValueError("solver='saddle' is only used with mass='full'; a lumped mass "
                                  "is solved exactly through its sparse Schur complement")
-            self._method = "lumped"
+            self.method = "lumped"
             self._minv = 1.0 / M_AA.diagonal()
             Q = self._Bmat @ sp.diags(self._minv) @ self._Bmat.T
             self._solve_Q = _factorize_spd(Q)
         else:
-            if self._method == "auto":
-                self._method = "saddle" if len(A) <= AUTO_SADDLE_MAX_VERTICES else "schur"
-            if self._method == "saddle":
+            if self.method == "auto":
+                self.method = "saddle" if len(A) <= AUTO_SADDLE_MAX_VERTICES else "schur"
+            if self.method == "saddle":
                 S = sp.bmat([[None, self._Bmat], [self._Bmat.T, -M_AA]], format="csc")
                 self._solve_saddle = _factorize_general(S)
             else:
@@ -450,10 +454,10 @@ class BiharmonicSolver:
             r -= self.K @ gB
         r = r[A]
         Bm = self._Bmat
-        if self._method == "saddle":
+        if self.method == "saddle":
             x = self._solve_saddle(np.concatenate([b, r]))
             x1, x2 = x[: len(I)], x[len(I):]
-        elif self._method == "lumped":
+        elif self.method == "lumped":
             x1 = self._solve_Q(b + Bm @ (self._minv * r))
             x2 = self._minv * (Bm.T @ x1 - r)
         else:

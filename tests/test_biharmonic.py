@@ -213,6 +213,8 @@ def test_saddle_and_schur_solvers_agree():
     S = BiharmonicSolver(V, F, solver="schur", rtol=1e-12)
     b = S.solve(P.f, g=g, q=q)
     assert 5 <= S.last_iterations <= 40          # preconditioned spectrum in [1, 4]
+    assert S.method == "schur" and BiharmonicSolver(V, F).method == "saddle"
+    assert BiharmonicSolver(V, F, mass="lumped").method == "lumped"
     for x, y in zip(a, b):
         np.testing.assert_allclose(x, y, atol=1e-8 * np.abs(x).max())
 

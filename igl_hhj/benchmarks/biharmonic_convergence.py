@@ -187,7 +187,7 @@ def performance_study(max_vertices=600_000, rings=7, seed=0, progress=True, log=
         f = H.f(V)
         S, r["full_setup"] = _timed(lambda: BiharmonicSolver(V, F, mass="full"))
         (u1f, _), r["full_solve"] = _timed(lambda: S.solve(f))
-        r["full_method"] = S._method
+        r["full_method"] = S.method
         r["full_pcg_iterations"] = S.last_iterations
         del S
         Sl, r["lumped_setup"] = _timed(lambda: BiharmonicSolver(V, F, mass="lumped"))
