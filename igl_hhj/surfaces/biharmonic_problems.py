@@ -29,51 +29,16 @@ from __future__ import annotations
 
 import numpy as np
 
+from .meshing import refine
+
 __all__ = [
     "BiharmonicProblem", "SphericalCapProblem", "Hemisphere", "SphereHarmonicsProblem",
-    "LanternProblem", "DiskPlateProblem", "disk_mesh", "cap_mesh", "refine_with_boundary",
+    "LanternProblem", "DiskPlateProblem", "disk_mesh", "cap_mesh",
     "schwarz_lantern", "lantern_sequence", "biharmonic_errors",
 ]
 
 
 # ---------------------------------------------------------------- meshing helpers
-def _boundary_vertex_mask(F, n):
-    import igl
-    mask = np.zeros(n, dtype=bool)
-    for loop in igl.boundary_loop_all(np.asarray(F, dtype=np.int64)):
-        mask[np.asarray(loop, dtype=np.int64)] = True
-    return mask
-
-
-def refine_with_boundary(V, F, project, project_boundary, levels=1):
-    """``levels`` uniform refinements (``igl.upsample``, 1 → 4 triangles).
-
-    New interior vertices are mapped by ``project`` (onto the surface), new
-    boundary vertices by ``project_boundary`` (onto the boundary curve); old
-    vertices keep their index and position.
-
-    Returns
-    -------
-    V : (#V', 3) float64, F : (#F', 3) int64
-    """
-    import igl
-    V = np.asarray(V, dtype=np.float64)
-    F = np.asarray(F, dtype=np.int64)
-    for _ in range(levels):
-        n_old = len(V)
-        V, F = igl.upsample(V, F)
-        V = np.array(V)
-        F = np.asarray(F, dtype=np.int64)
-        new = np.zeros(len(V), dtype=bool)
-        new[n_old:] = True
-        bnd = _boundary_vertex_mask(F, len(V))
-        if (new & ~bnd).any():
-            V[new & ~bnd] = project(V[new & ~bnd])
-        if (new & bnd).any():
-            V[new & bnd] = project_boundary(V[new & bnd])
-    return V, F
-
-
 def _disk_parameter_mesh(rings=3, amount=0.25, seed=0):
     """Jittered Delaunay mesh of the unit disk: a centre point and rings k = 1..K
     of 6k points at radius k/K (boundary ring exactly on the circle, jittered
@@ -128,7 +93,7 @@ def disk_mesh(levels=0, rings=3, amount=0.25, seed=0, radius=1.0):
         X[:, 2] = 0.0
         return X
 
-    return refine_with_boundary(V, F, lambda X: X, to_circle, levels)
+    return refine(V, F, lambda X: X, levels, project_boundary=to_circle)
 
 
 def cap_mesh(theta0=np.pi / 2, levels=0, rings=3, amount=0.25, seed=0):
@@ -160,7 +125,7 @@ def cap_mesh(theta0=np.pi / 2, levels=0, rings=3, amount=0.25, seed=0):
         return np.column_stack([np.sin(theta0) * X[:, :2] / r,
                                 np.full(len(X), np.cos(theta0))])
 
-    return refine_with_boundary(V, F, to_sphere, to_circle, levels)
+    return refine(V, F, to_sphere, levels, project_boundary=to_circle)
 
 
 def schwarz_lantern(m, n, perturbation=0.0, seed=0, radius=1.0, height=1.0):

@@ -11,24 +11,58 @@ import numpy as np
 from .exact import Ellipsoid, GraphSurface, ImplicitSurface, Sphere, WalkerTorus
 
 __all__ = [
-    "refine", "mesh_sequence", "jitter_tangentially", "icosphere",
+    "refine", "boundary_vertex_mask", "mesh_sequence", "jitter_tangentially", "icosphere",
     "ellipsoid_coarse", "torus_coarse", "square_grid", "graph_coarse",
 ]
 
 
-def refine(V, F, surface: ImplicitSurface, levels=1):
-    """``levels`` uniform refinements (``igl.upsample``), new vertices projected onto ``surface``.
+def boundary_vertex_mask(F, n_vertices):
+    """(#V,) bool: vertices on an edge used by exactly one face (vectorised, no validation)."""
+    F = np.asarray(F, dtype=np.int64)
+    E = np.sort(np.concatenate([F[:, [1, 2]], F[:, [2, 0]], F[:, [0, 1]]]), axis=1)
+    uE, count = np.unique(E, axis=0, return_counts=True)
+    mask = np.zeros(n_vertices, dtype=bool)
+    mask[uE[count == 1].ravel()] = True
+    return mask
+
+
+def refine(V, F, surface, levels=1, project_boundary=None):
+    """``levels`` uniform refinements (``igl.upsample``, 1 → 4 triangles) with
+    the new vertices projected.
+
+    Parameters
+    ----------
+    V, F : the mesh (its vertices are assumed to lie on the surface already).
+    surface : ImplicitSurface or callable
+        New vertices are mapped by ``surface.project`` (or by ``surface`` itself
+        when it is a callable ``(n, 3) -> (n, 3)``).
+    levels : int
+    project_boundary : callable, optional
+        If given, new vertices on the boundary are mapped by it instead (e.g.
+        onto a curved boundary), the others by ``surface``.
 
     Old vertices keep their index and position (``igl.upsample`` appends the
-    edge midpoints), so only the appended ones are projected."""
+    edge midpoints), so only the appended ones are moved.
+    """
     import igl
+    project = surface.project if hasattr(surface, "project") else surface
     V = np.asarray(V, dtype=np.float64)
     F = np.asarray(F, dtype=np.int64)
     for _ in range(levels):
         n_old = len(V)
         V, F = igl.upsample(V, F)
         V = np.array(V)
-        V[n_old:] = surface.project(V[n_old:])
+        F = np.asarray(F, dtype=np.int64)
+        new = np.zeros(len(V), dtype=bool)
+        new[n_old:] = True
+        if project_boundary is None:
+            V[new] = project(V[new])
+            continue
+        bnd = boundary_vertex_mask(F, len(V))
+        if (new & ~bnd).any():
+            V[new & ~bnd] = project(V[new & ~bnd])
+        if (new & bnd).any():
+            V[new & bnd] = project_boundary(V[new & bnd])
     return V, F
 
 
