@@ -29,6 +29,7 @@ import time
 
 import numpy as np
 
+from . import progress as progress_bar
 from ..biharmonic import BiharmonicSolver, biharmonic_solve, mass_matrix, stiffness_matrix
 from ..convergence import eoc
 from ..mesh import TriangleMesh
@@ -174,14 +175,7 @@ def performance_study(max_vertices=600_000, rings=7, seed=0, progress=True, log=
             break
         levels.append(lev)
         lev += 1
-    it = levels
-    if progress:
-        try:
-            from tqdm import tqdm
-            it = tqdm(levels, desc="perf", unit="mesh")
-        except ImportError:  # pragma: no cover
-            pass
-    for lev in it:
+    for lev in progress_bar(levels, "perf", "mesh", progress):
         V, F = cap_mesh(np.pi / 2, lev, rings=rings, seed=seed)
         r = {"n_vertices": len(V), "n_faces": len(F)}
         f = H.f(V)
@@ -284,15 +278,8 @@ def run(levels=5, seed=0, out="benchmark-results", perf=False, perf_max_vertices
     log = print if verbose else (lambda *a, **k: None)
     os.makedirs(out, exist_ok=True)
     todo = [c for c in _cases(levels, seed) if cases is None or c[0] in cases]
-    it = todo
-    if progress:
-        try:
-            from tqdm import tqdm
-            it = tqdm(todo, desc="cases", unit="case")
-        except ImportError:  # pragma: no cover
-            pass
     results, rates, tables = {}, {}, []
-    for name, problem, kw, meshes in it:
+    for name, problem, kw, meshes in progress_bar(todo, "cases", "case", progress):
         rows = convergence_study(problem, meshes(), **kw)
         results[name] = rows
         hs = [r["h"] for r in rows]

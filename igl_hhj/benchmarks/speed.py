@@ -19,6 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
+from . import progress as progress_bar
+
 SOLVERS = ("auto", "cg", "direct")
 # splu's fill grows superlinearly: above this many faces the direct column is skipped
 DIRECT_MAX_FACES = 400_000
@@ -60,15 +62,8 @@ def run(max_faces=1_400_000, repeat=1, solvers=SOLVERS, progress=True):
 
     import igl_hhj
     meshes = list(_meshes(max_faces))
-    it = meshes
-    if progress:
-        try:
-            from tqdm import tqdm
-            it = tqdm(meshes, desc="speed", unit="mesh")
-        except ImportError:  # pragma: no cover - tqdm is in the benchmark extra
-            pass
     rows = []
-    for name, V, F in it:
+    for name, V, F in progress_bar(meshes, "speed", "mesh", progress):
         row = {"surface": name, "faces": len(F)}
         row["libigl"] = _time(lambda: igl.principal_curvature(V, F), repeat)
         for s in solvers:
