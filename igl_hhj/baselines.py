@@ -336,15 +336,9 @@ def heine_weingarten_map(V, F):
     W = -G + (Yf + Yf.sum(axis=1, keepdims=True)) / 12.0             # (#F, c, k)
     C = A[:, None, None, None] * nu_T[:, None, :, None] * W[:, :, None, :]   # (#F, c, j, k)
     nV = mesh.n_vertices
-    v = mesh.F.ravel()
-    R = np.empty((nV, 9))
-    Cf = C.reshape(-1, 9)
-    for m in range(9):   # the 9 tensor components; vectorised over all corners
-        R[:, m] = np.bincount(v, weights=Cf[:, m], minlength=nV)
-    Rn = np.empty((nV, 3))
-    nuc = np.repeat(nu_T * (A / 3.0)[:, None], 3, axis=0)           # ∫_T ν_T λ_c = ν_T |T|/3
-    for k in range(3):
-        Rn[:, k] = np.bincount(v, weights=nuc[:, k], minlength=nV)
+    R = mesh.sum_corners_to_vertices(C).reshape(nV, 9)
+    nuc = np.broadcast_to((nu_T * (A / 3.0)[:, None])[:, None], (mesh.n_faces, 3, 3))  # ∫_T ν_T λ_c
+    Rn = mesh.sum_corners_to_vertices(nuc)
     X = _mass_solve(mesh, M, np.concatenate([R, Rn], axis=1))
     Pi = X[:, :9].reshape(nV, 3, 3)
     nu = X[:, 9:]

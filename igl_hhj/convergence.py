@@ -81,7 +81,7 @@ def vertex_errors(V, F, PV1, PV2, surface, mask=None):
     """
     mesh = as_mesh(V, F)
     k1, k2 = surface.principal_curvatures(mesh.V)
-    w = np.bincount(mesh.F.ravel(), weights=np.repeat(mesh.face_areas / 3, 3), minlength=mesh.n_vertices)
+    w = mesh.sum_corners_to_vertices(np.broadcast_to(mesh.face_areas[:, None] / 3, (mesh.n_faces, 3)))
     if mask is None:
         mask = mesh.referenced_vertices
     w = np.where(mask, w, 0.0)

@@ -319,15 +319,11 @@ def vertex_shape_operator(mesh, S):
     N : (#V, 3) vertex normals used
     """
     N = mesh.vertex_normals
-    w = np.repeat(mesh.face_areas, 3)
-    v = mesh.F.ravel()
-    Sc = np.repeat(S, 3, axis=0)                         # corners, (3#F, 3, 3)
-    acc = np.zeros((mesh.n_vertices, 9))
-    for j in range(9):  # 9 tensor components, vectorised over all corners
-        acc[:, j] = np.bincount(v, weights=w * Sc[:, j // 3, j % 3], minlength=mesh.n_vertices)
-    wsum = np.bincount(v, weights=w, minlength=mesh.n_vertices)
+    A = np.broadcast_to(mesh.face_areas[:, None], (mesh.n_faces, 3))
+    acc = mesh.sum_corners_to_vertices(A[:, :, None, None] * S[:, None])
+    wsum = mesh.sum_corners_to_vertices(A)
     with np.errstate(invalid="ignore", divide="ignore"):
-        Sv = (acc / wsum[:, None]).reshape(-1, 3, 3)
+        Sv = acc / wsum[:, None, None]
     P = np.eye(3)[None] - N[:, :, None] * N[:, None, :]
     Sv = P @ Sv @ P
     return Sv, N

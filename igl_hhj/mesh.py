@@ -303,6 +303,27 @@ class TriangleMesh:
         N[~self.referenced_vertices] = np.nan
         return N
 
+    def sum_corners_to_vertices(self, values):
+        """Scatter-add per-corner values to the vertices.
+
+        Parameters
+        ----------
+        values : (#F, 3, ...) array, ``values[f, c]`` belongs to vertex ``F[f, c]``.
+
+        Returns
+        -------
+        (#V, ...) float64: for each vertex the sum over its corners (0 for
+        unreferenced vertices).
+        """
+        values = np.asarray(values, dtype=np.float64)
+        tail = values.shape[2:]
+        flat = values.reshape(3 * self.n_faces, -1)
+        v = self.F.ravel()
+        out = np.empty((self.n_vertices, flat.shape[1]))
+        for j in range(flat.shape[1]):  # value components; vectorised over all corners
+            out[:, j] = np.bincount(v, weights=flat[:, j], minlength=self.n_vertices)
+        return out.reshape((self.n_vertices,) + tail)
+
     # ------------------------------------------------------------ checks
     def _check_degenerate(self):
         l2max = (self._edge_vectors ** 2).sum(axis=2).max(axis=1)
