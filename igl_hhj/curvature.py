@@ -254,8 +254,7 @@ def face_principal_curvature(V, F, **boundary):
     PV1, PV2 : (#F,) principal curvatures κ1 ≥ κ2.
     """
     mesh = as_mesh(V, F)
-    S = _shape_operator(mesh, boundary.get("boundary_normals"), boundary.get("boundary_shape_operator"),
-                        boundary.get("simply_supported"), boundary.get("solver", "auto"))
+    S = shape_operator(mesh, None, **boundary)   # the validated mesh passes through as_mesh
     return principal_from_shape_operator(S, mesh.face_normals)
 
 
@@ -268,7 +267,7 @@ def face_mean_curvature(V, F, **boundary):
 def face_gaussian_curvature(V, F, **boundary):
     """Per-face Gauss curvature K = κ1 κ2 = det(S_h + ν_T ⊗ ν_T) (Walker eq. 6.1), shape (#F,)."""
     mesh = as_mesh(V, F)
-    S = shape_operator(mesh.V, mesh.F, **boundary)
+    S = shape_operator(mesh, None, **boundary)
     nu = mesh.face_normals
     return np.linalg.det(S + nu[:, :, None] * nu[:, None, :])
 

@@ -257,6 +257,8 @@ def test_boundary_argument_errors():
         igl_hhj.surface_hessian(V, F, w)
     with pytest.raises(ValueError, match="unknown solver"):
         igl_hhj.shape_operator(V, F, solver="magic")
+    with pytest.raises(TypeError, match="boundary_normal"):
+        igl_hhj.face_principal_curvature(V, F, boundary_normal=N)   # misspelled keyword
 
 
 def test_interior_data_rows_may_be_nan():

@@ -122,3 +122,14 @@ def test_boundary_edges_and_loops():
     assert set(np.flatnonzero(m.boundary_vertices)) == set(L.tolist())
     assert len(m.boundary_loops) == 1 and len(m.boundary_loops[0]) == len(L)
     assert m.boundary_edges.sum() == len(L)
+
+
+def test_sum_corners_to_vertices():
+    V, F = icosphere(1)
+    m = TriangleMesh(np.vstack([V, [[3.0, 3, 3]]]), F)       # one unreferenced vertex
+    third = np.broadcast_to(m.face_areas[:, None] / 3, (m.n_faces, 3))
+    w = m.sum_corners_to_vertices(third)
+    assert w.shape == (m.n_vertices,) and w[-1] == 0.0
+    np.testing.assert_allclose(w.sum(), m.face_areas.sum())
+    vec = m.sum_corners_to_vertices(np.ones((m.n_faces, 3, 2, 2)))
+    np.testing.assert_array_equal(vec[:-1, 0, 1], np.bincount(F.ravel()))
