@@ -1,160 +1,666 @@
-"""Polyscope helpers: HHJ face curvatures beside libigl's vertex curvatures.
+"""Polyscope viewers for igl_hhj results: curvature (HHJ beside libigl), surface
+Hessians, biharmonic solutions and Regge Gauss curvature.
 
-polyscope is imported lazily inside every function.  Nothing here calls
-``ps.show()``: interactive use is ``register_comparison(V, F); ps.show()``
-(see ``demos/compare_curvature.py``); headless rendering is
-:func:`screenshot` (EGL backend; on Debian needs the packages ``libegl1
-libegl-mesa0 libgl1-mesa-dri``).
+polyscope is imported lazily inside the functions, so ``import igl_hhj`` never
+loads it.  Every ``register_*`` function
 
-Colour ranges: for each quantity (κ1, κ2, H, K) the HHJ mesh and the libigl
-mesh share one range, the 5th–95th percentile (by default) of both value sets together
-(symmetric about 0 for K and for signed data that changes sign), so the two
-pictures are directly comparable.
+* validates the mesh like the core API (``ValueError``/``TypeError``),
+* registers polyscope structures and quantities and returns a
+  :class:`Registration` describing exactly what it registered (names, values,
+  element type, colour ranges) — the thing tests and scripts inspect,
+* takes ``screenshot="out.png"`` to render **headless** (EGL backend; on
+  Debian/Ubuntu install ``libegl1 libegl-mesa0 libgl1-mesa-dri``) only the
+  structures of this call and write a PNG.
+
+Interactive use::
+
+    from igl_hhj import viewer
+    viewer.register_comparison(V, F)   # HHJ (left) and libigl (right), same colour ranges
+    viewer.show()
+
+Colour maps: signed curvature-like quantities use a diverging map
+(``coolwarm``) with a range **symmetric about 0** by default, so white is
+zero curvature; ``robust=p`` takes the range from the ``[p, 100-p]``
+percentiles instead of the extremes (ignores outliers, e.g. at sharp features of
+scanned meshes).  Quantities compared side by side (HHJ and libigl values of the
+same curvature) always share one range.  NaN values (undefined, e.g.
+unreferenced vertices) are shown as 0 and kept as NaN in the
+:class:`Registration`.
+
+Principal directions are vector quantities on faces or vertices, drawn as
+tangent segments whose length is ``direction_scale`` times the local mean edge
+length (``vectortype="ambient"``), so they stay readable on graded meshes.
+Principal directions are lines: their sign is arbitrary.
 """
 from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from .mesh import as_mesh
 
-__all__ = ["init", "shared_range", "curvature_fields", "register_comparison", "screenshot",
-           "QUANTITIES"]
+__all__ = [
+    "ViewerUnavailable", "QuantityInfo", "Registration", "QUANTITIES", "METHODS",
+    "init", "show", "color_range", "curvature_estimate", "local_edge_length",
+    "register_curvature", "register_comparison", "register_hessian", "register_biharmonic",
+    "register_regge_curvature", "screenshot",
+]
 
 QUANTITIES = ("k1", "k2", "H", "K")
-_SHOT = 0
-_LABEL = {"k1": "kappa1", "k2": "kappa2", "H": "mean H", "K": "Gauss K"}
+METHODS = ("hhj", "igl", "heine")
+LABELS = {"k1": "kappa1", "k2": "kappa2", "H": "mean H", "K": "Gauss K"}
+_TAG = {"hhj": "HHJ", "igl": "libigl", "heine": "Heine"}
+_EGL_HINT = ("headless rendering needs EGL: on Debian/Ubuntu `apt-get install libegl1 libegl-mesa0 "
+             "libgl1-mesa-dri`")
+_REGISTERED = {}  # structure name -> polyscope structure, everything this module registered
+
+
+class ViewerUnavailable(RuntimeError):
+    """polyscope could not open the requested rendering backend (no display, no EGL, ...)."""
+
+
+@dataclass(frozen=True)
+class QuantityInfo:
+    """One registered polyscope quantity.
+
+    Attributes
+    ----------
+    values : (n,) or (n, 3) float64, the values as computed (NaN kept).
+    defined_on : {"vertices", "faces"}
+    kind : {"scalar", "vector"}
+    vminmax : (lo, hi) colour range of a scalar quantity, None for vectors.
+    cmap : str or None, colour map of a scalar quantity.
+    enabled : bool, shown when the picture opens.
+    """
+
+    values: np.ndarray
+    defined_on: str
+    kind: str
+    vminmax: tuple | None = None
+    cmap: str | None = None
+    enabled: bool = False
+
+
+@dataclass
+class Registration:
+    """What a ``register_*`` call registered.
+
+    Attributes
+    ----------
+    structures : dict, structure name -> polyscope structure.
+    quantities : dict, (structure name, quantity name) -> :class:`QuantityInfo`.
+    ranges : dict, quantity key (e.g. "H") -> (lo, hi) colour range shared by
+        every structure showing that quantity.
+    screenshot : str or None, the PNG written (``screenshot=`` argument).
+    bounds : (2, 3) float64 or None, bounding box of the registered vertices.
+    """
+
+    structures: dict = field(default_factory=dict)
+    quantities: dict = field(default_factory=dict)
+    ranges: dict = field(default_factory=dict)
+    screenshot: str | None = None
+    bounds: np.ndarray | None = None
+
+    def names(self, structure):
+        """Quantity names registered on ``structure``."""
+        return [q for s, q in self.quantities if s == structure]
+
+
+# --------------------------------------------------------------------------- backend
+def _backend_name(ps):
+    try:
+        return ps.get_render_engine_backend_name()
+    except Exception:  # pragma: no cover - older polyscope
+        return ""
 
 
 def init(backend="auto"):
-    """Initialise polyscope once (``backend``: "auto", "openGL3_egl", "openGL_mock", ...).
+    """Initialise polyscope and return the ``polyscope`` module.
 
-    Returns the ``polyscope`` module."""
+    Parameters
+    ----------
+    backend : str
+        ``"auto"`` keeps whatever backend is running (or lets polyscope choose);
+        ``"openGL3_egl"`` renders without a display; ``"openGL_mock"`` renders
+        nothing (unit tests).  Asking for a backend other than the running one
+        shuts polyscope down (dropping every structure) and restarts it.
+
+    Raises
+    ------
+    ViewerUnavailable
+        The backend cannot be opened (e.g. no display for ``"auto"``, EGL
+        libraries missing for ``"openGL3_egl"``).
+    """
     import polyscope as ps
-    if not ps.is_initialized():
+    if ps.is_initialized():
+        if backend == "auto" or _backend_name(ps) == backend:
+            return ps
+        ps.shutdown()
+        _REGISTERED.clear()
+    try:
         ps.init(backend)
+    except Exception as exc:
+        hint = f"; {_EGL_HINT}" if "egl" in backend.lower() else ""
+        raise ViewerUnavailable(f"polyscope could not initialise backend {backend!r}: {exc}{hint}") from exc
     return ps
 
 
-def shared_range(*arrays, percentile=2.0):
-    """One colour range for several value arrays (NaNs ignored).
+def show():
+    """Open polyscope's interactive window on everything registered (needs a display)."""
+    init("auto").show()
 
-    Returns ``(lo, hi)``: the [p, 100-p] percentiles of all values together;
-    if they straddle 0 the range is made symmetric (``±max(|lo|, |hi|)``)."""
-    vals = np.concatenate([np.asarray(a, dtype=np.float64).ravel() for a in arrays])
+
+# --------------------------------------------------------------------------- values
+def color_range(*arrays, symmetric=True, robust=None):
+    """One colour range for several value arrays (NaN/inf ignored).
+
+    Parameters
+    ----------
+    *arrays : array_like
+    symmetric : bool, default True
+        Return ``(-m, m)`` with ``m`` the largest magnitude (diverging maps:
+        white is 0).
+    robust : float or None
+        Percentile ``p`` in [0, 50): use the ``[p, 100-p]`` percentiles instead
+        of min/max, ignoring outliers.
+
+    Returns
+    -------
+    (lo, hi) : floats with ``lo < hi`` (``(-1, 1)`` if no finite value).
+    """
+    if robust is not None and not (0.0 <= float(robust) < 50.0):
+        raise ValueError(f"robust must be a percentile in [0, 50), got {robust!r}")
+    vals = np.concatenate([np.asarray(a, dtype=np.float64).ravel() for a in arrays]) if arrays else np.zeros(0)
     vals = vals[np.isfinite(vals)]
     if vals.size == 0:
         return (-1.0, 1.0)
-    lo, hi = np.percentile(vals, [percentile, 100.0 - percentile])
-    if lo < 0 < hi:
-        m = max(-lo, hi)
+    if robust is None:
+        lo, hi = float(vals.min()), float(vals.max())
+    else:
+        lo, hi = (float(x) for x in np.percentile(vals, [float(robust), 100.0 - float(robust)]))
+    if symmetric:
+        m = max(abs(lo), abs(hi))
         lo, hi = -m, m
     if hi <= lo:
-        hi = lo + 1e-12
-    return float(lo), float(hi)
+        pad = max(abs(hi), 1.0) * 1e-6
+        lo, hi = lo - pad, hi + pad
+    return lo, hi
 
 
-def curvature_fields(V, F, *, solver="auto", radius=5):
-    """HHJ per-face and libigl per-vertex curvature fields of one mesh.
-
-    Returns
-    -------
-    hhj : CurvatureEstimate (location "face"), from :func:`igl_hhj.baselines.hhj_face`
-    igl : CurvatureEstimate (location "vertex"), from :func:`igl_hhj.baselines.libigl_quadric`
-    """
-    from .baselines import hhj_face, libigl_quadric
-    mesh = as_mesh(V, F)
-    return hhj_face(mesh.V, mesh.F, solver=solver), libigl_quadric(mesh.V, mesh.F, radius=radius)
-
-
-def register_comparison(V, F, *, name="mesh", fields=None, enabled="k1", offset=None,
-                        directions=True, cmap="coolwarm", percentile=5.0):
-    """Register two copies of the mesh: HHJ face curvatures and libigl vertex curvatures.
+def local_edge_length(mesh, location):
+    """Mean length of the edges of each face, or incident to each vertex.
 
     Parameters
     ----------
-    V, F : mesh (validated like the core API)
-    name : str, structure name prefix: ``"<name> HHJ"`` and ``"<name> libigl"``.
-    fields : (hhj, igl) pair from :func:`curvature_fields`, computed if None.
-    enabled : one of "k1", "k2", "H", "K" (or None): quantity shown first.
-    offset : (3,) translation of the libigl copy; default 1.2 × the bounding
-        box width along x.
-    directions : bool, also add the principal directions (face / vertex vectors).
-    percentile : float, colour range = [p, 100-p] percentiles (see :func:`shared_range`).
+    mesh : TriangleMesh
+    location : {"face", "vertex"}
 
     Returns
     -------
-    dict with keys "hhj" and "libigl" (the polyscope SurfaceMesh objects) and
-    "ranges" ({quantity: (lo, hi)}).
+    (#F,) or (#V,) float64 (unreferenced vertices get the global mean).
     """
-    if enabled is not None and enabled not in QUANTITIES:
-        raise ValueError(f"enabled must be one of {QUANTITIES} or None, got {enabled!r}")
-    mesh = as_mesh(V, F)
-    hhj, igl_ = curvature_fields(mesh.V, mesh.F) if fields is None else fields
-    ps = init()
-    if offset is None:
-        ext = mesh.V.max(axis=0) - mesh.V.min(axis=0)
-        offset = np.array([1.2 * ext[0], 0.0, 0.0])
-    offset = np.asarray(offset, dtype=np.float64).reshape(3)
-    m_h = ps.register_surface_mesh(f"{name} HHJ", mesh.V, mesh.F)
-    m_i = ps.register_surface_mesh(f"{name} libigl", mesh.V + offset, mesh.F)
-    ranges, added = {}, {}
+    if location == "face":
+        return mesh.edge_lengths.mean(axis=1)
+    ends = mesh.edges.ravel()
+    total = np.bincount(ends, weights=np.repeat(mesh.unique_edge_lengths, 2), minlength=mesh.n_vertices)
+    count = np.bincount(ends, minlength=mesh.n_vertices)
+    out = np.full(mesh.n_vertices, mesh.mean_edge_length)
+    np.divide(total, count, out=out, where=count > 0)
+    return out
+
+
+def curvature_estimate(V, F, *, method="hhj", per="face", **kwargs):
+    """Curvatures of one estimator as a :class:`igl_hhj.baselines.CurvatureEstimate`.
+
+    Parameters
+    ----------
+    method : {"hhj", "igl", "heine"}
+        HHJ shape operator (Walker), ``igl.principal_curvature`` (quadric fit),
+        or Heine's L2-projected Weingarten map.
+    per : {"face", "vertex"}
+        "face" exists for "hhj" only (the native per-face S_h); "vertex" is the
+        drop-in recovery for "hhj".
+    **kwargs : passed to the estimator (e.g. boundary data for "hhj",
+        ``radius`` for "igl").
+    """
+    from . import baselines
+    _check(method, "method", METHODS)
+    _check(per, "per", ("face", "vertex"))
+    if method == "hhj":
+        return (baselines.hhj_face if per == "face" else baselines.hhj_vertex)(V, F, **kwargs)
+    if per == "face":
+        raise ValueError(f"method {method!r} gives per-vertex curvature only; use per='vertex'")
+    return (baselines.libigl_quadric if method == "igl" else baselines.heine)(V, F, **kwargs)
+
+
+def _check(value, name, choices):
+    if value not in choices:
+        raise ValueError(f"{name} must be one of {choices}, got {value!r}")
+
+
+# --------------------------------------------------------------------------- registration helpers
+def _surface(ps, reg, name, V, F):
+    """Register a surface mesh under ``name``, replacing one of the same name."""
+    if ps.has_surface_mesh(name):
+        ps.remove_surface_mesh(name)
+    s = ps.register_surface_mesh(name, V, F)
+    reg.structures[name] = s
+    box = np.stack([V.min(axis=0), V.max(axis=0)])
+    reg.bounds = box if reg.bounds is None else np.stack([np.minimum(reg.bounds[0], box[0]),
+                                                          np.maximum(reg.bounds[1], box[1])])
+    _REGISTERED[name] = s
+    return s
+
+
+def _scalar(reg, sname, qname, values, defined_on, vminmax, cmap, enabled=False):
+    """Record a scalar quantity; :func:`_add_scalars` hands them to polyscope."""
+    values = np.asarray(values, dtype=np.float64)
+    reg.quantities[(sname, qname)] = QuantityInfo(values, defined_on, "scalar", tuple(float(x) for x in vminmax),
+                                                  cmap, bool(enabled))
+
+
+def _add_scalars(reg):
+    """Add the recorded scalar quantities, the enabled one of each structure last.
+
+    polyscope shows one colour quantity per structure and remembers a
+    quantity's "enabled" flag by name across re-registration; adding the
+    wanted one last makes it win regardless of what an earlier picture showed.
+    """
+    items = sorted(((k, q) for k, q in reg.quantities.items() if q.kind == "scalar"),
+                   key=lambda kq: kq[1].enabled)
+    for (sname, qname), q in items:
+        reg.structures[sname].add_scalar_quantity(
+            qname, np.nan_to_num(q.values, nan=0.0, posinf=0.0, neginf=0.0), defined_on=q.defined_on,
+            vminmax=q.vminmax, cmap=q.cmap, enabled=q.enabled)
+
+
+def _vector(reg, sname, qname, vectors, defined_on, enabled=False):
+    vectors = np.asarray(vectors, dtype=np.float64)
+    reg.structures[sname].add_vector_quantity(qname, np.nan_to_num(vectors), defined_on=defined_on,
+                                              vectortype="ambient", enabled=bool(enabled))
+    reg.quantities[(sname, qname)] = QuantityInfo(vectors, defined_on, "vector", None)
+
+
+def _add_estimate(reg, sname, mesh, est, tag, ranges, cmap, directions, direction_scale, enabled=None):
+    """Scalar (k1, k2, H, K) and direction quantities of one CurvatureEstimate."""
+    where = "faces" if est.location == "face" else "vertices"
     for q in QUANTITIES:
-        a, b = getattr(hhj, q), getattr(igl_, q)
-        ranges[q] = shared_range(a, b, percentile=percentile)
-        added[q] = (
-            m_h.add_scalar_quantity(f"{_LABEL[q]} (HHJ, faces)", np.nan_to_num(a), defined_on="faces",
-                                    vminmax=ranges[q], cmap=cmap, enabled=(q == enabled)),
-            m_i.add_scalar_quantity(f"{_LABEL[q]} (libigl, vertices)", np.nan_to_num(b), defined_on="vertices",
-                                    vminmax=ranges[q], cmap=cmap, enabled=(q == enabled)))
-    if enabled is not None:
-        # polyscope remembers "enabled" per structure/quantity name across
-        # re-registration; enable the wanted one last so it wins.
-        for qty in added[enabled]:
-            if qty is not None and hasattr(qty, "set_enabled"):
-                qty.set_enabled(True)
-    if directions:
-        for k, d in (("d1", "PD1"), ("d2", "PD2")):
-            if getattr(hhj, k) is not None:
-                m_h.add_vector_quantity(f"{d} (HHJ)", np.nan_to_num(getattr(hhj, k)), defined_on="faces",
-                                        vectortype="ambient", length=0.5 * mesh.mean_edge_length,
-                                        enabled=False)
-            if getattr(igl_, k) is not None:
-                m_i.add_vector_quantity(f"{d} (libigl)", np.nan_to_num(getattr(igl_, k)), defined_on="vertices",
-                                        vectortype="ambient", length=0.5 * mesh.mean_edge_length,
-                                        enabled=False)
-    return {"hhj": m_h, "libigl": m_i, "ranges": ranges}
+        _scalar(reg, sname, _qname(q, tag, est), getattr(est, q), where, ranges[q], cmap, enabled=(q == enabled))
+    if directions and est.d1 is not None:
+        scale = direction_scale * local_edge_length(mesh, est.location)[:, None]
+        for k, lab in (("d1", "PD1"), ("d2", "PD2")):
+            _vector(reg, sname, f"{lab} ({tag} {where})", getattr(est, k) * scale, where)
 
 
-def screenshot(V, F, path, *, quantity="k1", fields=None, backend="openGL3_egl", size=(1200, 600),
-               name="mesh", percentile=5.0):
-    """Render HHJ (left) and libigl (right) side by side for one quantity and save a PNG.
+def _qname(q, tag, est):
+    return f"{LABELS[q]} ({tag} {'faces' if est.location == 'face' else 'vertices'})"
+
+
+def _polyscope_for(screenshot):
+    """polyscope, initialised for interactive use or (``screenshot`` given) able to render."""
+    import polyscope as ps
+    if screenshot is not None and (not ps.is_initialized() or _backend_name(ps) == "openGL_mock"):
+        return init("openGL3_egl")
+    return init("auto")
+
+
+def _finish(reg, screenshot, size):
+    _add_scalars(reg)
+    if screenshot is not None:
+        _render(reg, screenshot, size)
+    return reg
+
+
+# --------------------------------------------------------------------------- curvature
+def register_curvature(V, F, estimate=None, *, method="hhj", per="both", name="mesh", enabled="H",
+                       directions=True, symmetric=True, robust=None, cmap="coolwarm", ranges=None,
+                       direction_scale=0.5, screenshot=None, size=(1024, 768), **estimator_kwargs):
+    """Register a mesh with its curvature: κ1, κ2, H, K (scalars) and principal directions.
 
     Parameters
     ----------
-    path : str or path-like, output PNG file.
-    quantity : "k1", "k2", "H" or "K" (same colour range on both copies).
-    fields : optional precomputed (hhj, igl) from :func:`curvature_fields`.
-    backend : polyscope backend; "openGL3_egl" renders without a display.
-    size : window size in pixels.
-    percentile : float, colour range percentile (see :func:`shared_range`).
+    V : (#V, 3) array_like, F : (#F, 3) array_like int (validated, never reordered)
+    estimate : CurvatureEstimate or sequence of them, optional
+        Precomputed result(s) (:func:`curvature_estimate`); then ``method`` and
+        ``per`` are ignored.
+    method : {"hhj", "igl", "heine"}
+    per : {"face", "vertex", "both"}, default "both"
+        For "hhj": the per-face S_h, the recovered per-vertex values, or both
+        (same colour ranges).  "igl"/"heine" are per vertex.
+    name : str, structure name.
+    enabled : one of "k1", "k2", "H", "K" or None, quantity shown first.
+    directions : bool, register PD1/PD2 vector quantities.
+    symmetric, robust : colour range (:func:`color_range`), shared by all
+        values of one quantity.
+    cmap : polyscope colour map name (diverging by default).
+    ranges : dict, optional, explicit ``{quantity: (lo, hi)}`` overriding the
+        computed ranges (e.g. to match another picture).
+    direction_scale : float, direction length in units of the local mean edge length.
+    screenshot : path, optional: render headless to this PNG (see :func:`screenshot`).
+    size : (width, height) of the screenshot in pixels.
+    **estimator_kwargs : passed to the estimator (boundary data, ``radius``...).
 
     Returns
     -------
-    (lo, hi) : the colour range used.
+    Registration (``ranges`` has keys "k1", "k2", "H", "K").
     """
-    if quantity not in QUANTITIES:
-        raise ValueError(f"quantity must be one of {QUANTITIES}, got {quantity!r}")
-    ps = init(backend)
-    ps.remove_all_structures()
-    ps.set_window_size(int(size[0]), int(size[1]))
+    if enabled is not None:
+        _check(enabled, "enabled", QUANTITIES)
+    mesh = as_mesh(V, F)
+    if estimate is None:
+        _check(per, "per", ("face", "vertex", "both"))
+        pers = ("face", "vertex") if per == "both" else (per,)
+        if method != "hhj" and per == "both":
+            pers = ("vertex",)
+        ests = [curvature_estimate(mesh.V, mesh.F, method=method, per=p, **estimator_kwargs) for p in pers]
+        tags = [_TAG[method]] * len(ests)
+    else:
+        ests = list(estimate) if isinstance(estimate, (list, tuple)) else [estimate]
+        tags = [_tag_of(e) for e in ests]
+    _check_sizes(mesh, ests)
+    ps = _polyscope_for(screenshot)
+    reg = Registration()
+    reg.ranges = {q: color_range(*(getattr(e, q) for e in ests), symmetric=symmetric, robust=robust)
+                  for q in QUANTITIES}
+    if ranges:
+        reg.ranges.update({k: tuple(v) for k, v in ranges.items()})
+    _surface(ps, reg, name, mesh.V, mesh.F)
+    for i, (est, tag) in enumerate(zip(ests, tags)):
+        _add_estimate(reg, name, mesh, est, tag, reg.ranges, cmap, directions, direction_scale,
+                      enabled=enabled if i == 0 else None)
+    return _finish(reg, screenshot, size)
+
+
+def _tag_of(est):
+    n = getattr(est, "name", "") or ""
+    if n.startswith("hhj"):
+        return "HHJ"
+    if n.startswith("libigl"):
+        return "libigl"
+    if n.startswith("heine"):
+        return "Heine"
+    return n or "estimate"
+
+
+def _check_sizes(mesh, ests):
+    for e in ests:
+        n = mesh.n_faces if e.location == "face" else mesh.n_vertices
+        if len(e.k1) != n:
+            raise ValueError(f"estimate {getattr(e, 'name', '')!r} has {len(e.k1)} {e.location} values, "
+                             f"the mesh has {n} {e.location}s")
+
+
+def register_comparison(V, F, *, hhj=None, libigl=None, per="face", layout="copy", name="mesh", enabled="H",
+                        directions=True, symmetric=True, robust=None, cmap="coolwarm", offset=None,
+                        direction_scale=0.5, radius=5, screenshot=None, size=(1600, 800)):
+    """HHJ curvature beside ``igl.principal_curvature`` on the same mesh, identical colour ranges.
+
+    Parameters
+    ----------
+    V, F : mesh
+    hhj, libigl : CurvatureEstimate, optional precomputed results (HHJ at
+        faces or vertices; libigl at vertices).
+    per : {"face", "vertex"}, where the HHJ values live if computed here.
+    layout : {"copy", "quantities"}
+        "copy": two structures, ``"<name> HHJ"`` and ``"<name> libigl"``, the
+        libigl one translated by ``offset``; "quantities": one structure
+        ``name`` carrying both sets of quantities.
+    offset : (3,) translation of the libigl copy; default 1.15 × the bounding
+        box width along x.
+    radius : libigl's ``radius`` (k-ring size).
+    other parameters : as :func:`register_curvature`.
+
+    Returns
+    -------
+    Registration; ``ranges[q]`` is the one range used by both estimators.
+    """
+    if enabled is not None:
+        _check(enabled, "enabled", QUANTITIES)
+    _check(layout, "layout", ("copy", "quantities"))
+    mesh = as_mesh(V, F)
+    if hhj is None:
+        hhj = curvature_estimate(mesh.V, mesh.F, method="hhj", per=per)
+    if libigl is None:
+        libigl = curvature_estimate(mesh.V, mesh.F, method="igl", per="vertex", radius=radius)
+    _check_sizes(mesh, [hhj, libigl])
+    ps = _polyscope_for(screenshot)
+    reg = Registration()
+    reg.ranges = {q: color_range(getattr(hhj, q), getattr(libigl, q), symmetric=symmetric, robust=robust)
+                  for q in QUANTITIES}
+    if layout == "copy":
+        if offset is None:
+            ext = mesh.V.max(axis=0) - mesh.V.min(axis=0)
+            offset = np.array([1.15 * ext[0], 0.0, 0.0])
+        offset = np.asarray(offset, dtype=np.float64).reshape(3)
+        sh, si = f"{name} HHJ", f"{name} libigl"
+        _surface(ps, reg, sh, mesh.V, mesh.F)
+        _surface(ps, reg, si, mesh.V + offset, mesh.F)
+    else:
+        sh = si = name
+        _surface(ps, reg, name, mesh.V, mesh.F)
+    _add_estimate(reg, sh, mesh, hhj, "HHJ", reg.ranges, cmap, directions, direction_scale, enabled=enabled)
+    _add_estimate(reg, si, mesh, libigl, "libigl", reg.ranges, cmap, directions, direction_scale,
+                  enabled=enabled if layout == "copy" else None)
+    return _finish(reg, screenshot, size)
+
+
+# --------------------------------------------------------------------------- other fields
+def register_hessian(V, F, w, *, boundary_gradient=None, name="mesh", label="w", enabled="trace",
+                     directions=True, symmetric=True, robust=None, cmap="coolwarm", direction_scale=0.5,
+                     screenshot=None, size=(1024, 768)):
+    """Register a P1 function ``w`` and its HHJ surface Hessian (Walker eq. 4.9).
+
+    Parameters
+    ----------
+    w : (#V,) array_like or callable ``w(V: (#V, 3)) -> (#V,)``
+    boundary_gradient : optional clamped data, see :func:`igl_hhj.surface_hessian`.
+    label : str, name of the function in the quantity names.
+    enabled : {"w", "lambda1", "lambda2", "trace", "norm"}, quantity shown first.
+
+    Registered (on structure ``name``): ``w`` (vertices, viridis), the
+    eigenvalues λ1 ≥ λ2 of the tangential Hessian and its trace (the surface
+    Laplacian Δ_Γ w) per face (diverging, λ1/λ2 share a range), its Frobenius
+    norm (faces), and the eigen-directions (face vectors).
+
+    Returns
+    -------
+    Registration; ``ranges`` keys "w", "lambda", "trace", "norm".
+    """
+    from .curvature import principal_from_shape_operator, surface_hessian
+    _check(enabled, "enabled", ("w", "lambda1", "lambda2", "trace", "norm"))
+    mesh = as_mesh(V, F)
+    wv = w(mesh.V.copy()) if callable(w) else w
+    wv = np.asarray(wv, dtype=np.float64)
+    if wv.shape != (mesh.n_vertices,):
+        raise ValueError(f"w must have shape ({mesh.n_vertices},), got {wv.shape}")
+    if not np.all(np.isfinite(wv)):
+        raise ValueError("w contains NaN or inf values")
+    Hw = surface_hessian(mesh.V, mesh.F, wv, boundary_gradient=boundary_gradient)
+    d1, d2, l1, l2 = principal_from_shape_operator(Hw, mesh.face_normals)
+    tr = np.trace(Hw, axis1=1, axis2=2)
+    nrm = np.linalg.norm(Hw, axis=(1, 2))
+    ps = _polyscope_for(screenshot)
+    reg = Registration()
+    reg.ranges = {"w": color_range(wv, symmetric=False),
+                  "lambda": color_range(l1, l2, symmetric=symmetric, robust=robust),
+                  "trace": color_range(tr, symmetric=symmetric, robust=robust),
+                  "norm": color_range(nrm, symmetric=False, robust=robust)}
+    _surface(ps, reg, name, mesh.V, mesh.F)
+    names = {"w": label, "lambda1": f"Hess {label} lambda1", "lambda2": f"Hess {label} lambda2",
+             "trace": f"Hess {label} trace (surface Laplacian)", "norm": f"|Hess {label}|"}
+    for key, vals, where, rng, cm in (("w", wv, "vertices", "w", "viridis"),
+                                      ("lambda1", l1, "faces", "lambda", cmap),
+                                      ("lambda2", l2, "faces", "lambda", cmap),
+                                      ("trace", tr, "faces", "trace", cmap),
+                                      ("norm", nrm, "faces", "norm", "viridis")):
+        _scalar(reg, name, names[key], vals, where, reg.ranges[rng], cm, enabled=(key == enabled))
+    if directions:
+        scale = direction_scale * local_edge_length(mesh, "face")[:, None]
+        _vector(reg, name, f"Hess {label} dir1", d1 * scale, "faces")
+        _vector(reg, name, f"Hess {label} dir2", d2 * scale, "faces")
+    return _finish(reg, screenshot, size)
+
+
+def register_biharmonic(V, F, u1, u2=None, *, exact=None, f=None, name="mesh", enabled="u1", symmetric=None,
+                        robust=None, screenshot=None, size=(1024, 768)):
+    """Register a mixed-P1 biharmonic solution (Stein et al.): ``u1 ≈ u``, ``u2 ≈ -Δu``.
+
+    Parameters
+    ----------
+    u1, u2 : (#V,) array_like (as returned by :func:`igl_hhj.biharmonic_solve`)
+    exact : (#V,) array_like or callable ``u(V) -> (#V,)``, optional: also
+        registers ``u`` and the error ``u1 - u`` (diverging, symmetric).
+    f : (#V,) array_like or callable, optional right-hand side (registered too).
+    enabled : {"u1", "u2", "u", "error", "f"}
+    symmetric : bool or None; None = symmetric (diverging map) when the values
+        change sign, else a sequential ``viridis`` range.
+
+    Returns
+    -------
+    Registration; ``ranges`` keys among "u1", "u2", "f", "error" (u shares u1's).
+    """
+    mesh = as_mesh(V, F)
+    n = mesh.n_vertices
+
+    def vertex_values(x, what):
+        x = x(mesh.V.copy()) if callable(x) else x
+        x = np.broadcast_to(np.asarray(x, dtype=np.float64), (n,)) if np.ndim(x) == 0 else np.asarray(x, float)
+        if x.shape != (n,):
+            raise ValueError(f"{what} must have shape ({n},), got {x.shape}")
+        return x
+
+    fields = {"u1": vertex_values(u1, "u1")}
+    if u2 is not None:
+        fields["u2"] = vertex_values(u2, "u2")
+    if exact is not None:
+        fields["u"] = vertex_values(exact, "exact")
+        fields["error"] = fields["u1"] - fields["u"]
+    if f is not None:
+        fields["f"] = vertex_values(f, "f")
+    _check(enabled, "enabled", tuple(fields))
+    ps = _polyscope_for(screenshot)
+    reg = Registration()
+    _surface(ps, reg, name, mesh.V, mesh.F)
+    for key in ("u1", "u2", "f", "error"):
+        if key not in fields:
+            continue
+        vals = [fields[key]] + ([fields["u"]] if key == "u1" and "u" in fields else [])
+        fin = np.concatenate(vals)
+        fin = fin[np.isfinite(fin)]
+        signed = key == "error" or (fin.size > 0 and fin.min() < 0 < fin.max())
+        sym = signed if symmetric is None else bool(symmetric)
+        reg.ranges[key] = color_range(*vals, symmetric=sym, robust=robust)
+        cm = "coolwarm" if sym else "viridis"
+        for k in [key] + (["u"] if key == "u1" and "u" in fields else []):
+            qname = {"u1": "u1 (approx. u)", "u2": "u2 (approx. -Laplacian u)", "u": "u exact",
+                     "error": "error u1 - u", "f": "f"}[k]
+            _scalar(reg, name, qname, fields[k], "vertices", reg.ranges[key], cm, enabled=(k == enabled))
+    return _finish(reg, screenshot, size)
+
+
+def register_regge_curvature(V, F, *, boundary="natural", mass="consistent", compare=True, name="mesh",
+                             enabled="K_h", symmetric=True, robust=None, cmap="coolwarm", screenshot=None,
+                             size=(1024, 768)):
+    """Register the Regge (degree-0, edge-length metric) Gauss curvature K_h (paper 004).
+
+    Parameters
+    ----------
+    boundary, mass : see :func:`igl_hhj.regge.gauss_curvature`.
+    compare : bool, also register the pointwise angle defect density
+        (libigl ``gaussian_curvature`` / barycentric area, vertices) and the HHJ
+        Gauss curvature ``det(S_h + ν⊗ν)`` (faces), all on K_h's colour range.
+    enabled : {"K_h", "angle_defect", "hhj"}
+
+    Returns
+    -------
+    Registration; ``ranges["K"]`` is the shared range.
+    """
+    import igl
+
+    from .regge import gauss_curvature
+    _check(enabled, "enabled", ("K_h", "angle_defect", "hhj") if compare else ("K_h",))
+    mesh = as_mesh(V, F)
+    Kh = gauss_curvature(mesh.V, mesh.F, boundary=boundary, mass=mass)
+    fields = {"K_h": ("Regge K_h (vertices)", Kh, "vertices")}
+    if compare:
+        from .curvature import face_gaussian_curvature
+        M = igl.massmatrix(mesh.V, mesh.F, igl.MASSMATRIX_TYPE_BARYCENTRIC).diagonal()
+        M = np.pad(M, (0, mesh.n_vertices - len(M)))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            defect = np.asarray(igl.gaussian_curvature(mesh.V, mesh.F), dtype=np.float64) / M
+        defect = np.pad(defect, (0, mesh.n_vertices - len(defect)), constant_values=np.nan)
+        defect[~mesh.referenced_vertices | mesh.boundary_vertices] = np.nan
+        fields["angle_defect"] = ("angle defect / area (vertices)", defect, "vertices")
+        fields["hhj"] = ("HHJ Gauss K (faces)", face_gaussian_curvature(mesh.V, mesh.F), "faces")
+    ps = _polyscope_for(screenshot)
+    reg = Registration()
+    reg.ranges["K"] = color_range(Kh, symmetric=symmetric, robust=robust)
+    _surface(ps, reg, name, mesh.V, mesh.F)
+    for key, (qname, vals, where) in fields.items():
+        _scalar(reg, name, qname, vals, where, reg.ranges["K"], cmap, enabled=(key == enabled))
+    return _finish(reg, screenshot, size)
+
+
+# --------------------------------------------------------------------------- rendering
+def _render(reg, path, size):
+    """Write a PNG of the structures of ``reg`` (others hidden during the shot)."""
+    path = os.fspath(path)
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise ValueError(f"cannot write screenshot {path!r}: directory {folder!r} does not exist")
+    if not os.access(folder, os.W_OK):
+        raise ValueError(f"cannot write screenshot {path!r}: directory {folder!r} is not writable")
+    w, h = (int(x) for x in size)
+    if w < 16 or h < 16:
+        raise ValueError(f"screenshot size must be at least 16 x 16 pixels, got {size!r}")
+    import polyscope as ps
+    if not ps.is_initialized() or _backend_name(ps) == "openGL_mock":
+        raise ViewerUnavailable("polyscope's mock backend draws nothing; register with screenshot=... "
+                                "(which starts the EGL backend) or call viewer.init('openGL3_egl') first")
+    ps.set_window_size(w, h)
     ps.set_ground_plane_mode("none")
-    global _SHOT
-    _SHOT += 1
-    # A fresh structure name per picture: re-registering a *different* mesh under
-    # the same names leaves the first screenshot without its scalar quantity
-    # (polyscope keeps per-name state; measured with the EGL backend).
-    reg = register_comparison(V, F, name=f"{name} {_SHOT}", fields=fields, enabled=quantity, directions=False,
-                              percentile=percentile)
-    ps.reset_camera_to_home_view()
-    ps.screenshot(str(path), transparent_bg=False)
-    return reg["ranges"][quantity]
+    hidden = [s for n, s in _REGISTERED.items() if n not in reg.structures and s.is_enabled()]
+    for s in hidden:
+        s.set_enabled(False)
+    for s in reg.structures.values():
+        s.set_enabled(True)
+    try:
+        if reg.bounds is not None:
+            # frame only this call's structures (hidden ones still count in polyscope's extents)
+            ps.set_automatically_compute_scene_extents(False)
+            ps.set_bounding_box(reg.bounds[0], reg.bounds[1])
+            ps.set_length_scale(0.5 * float(np.linalg.norm(reg.bounds[1] - reg.bounds[0])))
+        ps.reset_camera_to_home_view()
+        ps.screenshot(path, transparent_bg=False)
+    finally:
+        for s in hidden:
+            s.set_enabled(True)
+        ps.set_automatically_compute_scene_extents(True)
+    reg.screenshot = path
+    return path
+
+
+def screenshot(path, registration=None, *, size=(1024, 768)):
+    """Render headless (EGL, unless an interactive backend is running) and save a PNG.
+
+    Parameters
+    ----------
+    path : str or path-like, the PNG to write (its directory must exist).
+    registration : Registration, optional: only its structures are drawn
+        (everything registered through this module otherwise).
+    size : (width, height) in pixels.
+
+    Returns
+    -------
+    str, the path written.
+
+    Raises
+    ------
+    ViewerUnavailable : no backend can render (e.g. EGL libraries missing).
+    ValueError : unwritable path or bad size.
+    """
+    if registration is None:
+        registration = Registration(structures=dict(_REGISTERED))
+    return _render(registration, path, size)

@@ -299,8 +299,9 @@ def real_meshes(folder, estimators, outdir, screenshots, progress):
                 from .. import viewer
                 for q in ("k1", "k2"):
                     fn = outdir / f"real_{path.stem}_{q}.png"
-                    viewer.screenshot(V, F, fn, quantity=q, fields=(ests["hhj_face"], ests["libigl_quadric"]),
-                                      size=(1000, 500))
+                    viewer.register_comparison(V, F, hhj=ests["hhj_face"], libigl=ests["libigl_quadric"],
+                                               enabled=q, robust=5.0, directions=False, screenshot=fn,
+                                               size=(1000, 500))
                     row["shots"].append(fn.name)
             except Exception as exc:
                 row["shots_error"] = f"{type(exc).__name__}: {exc}"
