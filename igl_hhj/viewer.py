@@ -45,7 +45,7 @@ __all__ = [
     "ViewerUnavailable", "QuantityInfo", "Registration", "QUANTITIES", "METHODS",
     "init", "show", "color_range", "curvature_estimate", "local_edge_length",
     "register_curvature", "register_comparison", "register_hessian", "register_biharmonic",
-    "register_regge_curvature", "screenshot",
+    "register_regge_curvature", "register_scalars", "merge", "screenshot",
 ]
 
 QUANTITIES = ("k1", "k2", "H", "K")
@@ -603,6 +603,63 @@ def register_regge_curvature(V, F, *, boundary="natural", mass="consistent", com
     return _finish(reg, screenshot, size)
 
 
+def register_scalars(V, F, fields, *, name="mesh", enabled=None, shared_range=False, symmetric=True, robust=None,
+                     cmap="coolwarm", offset=None, screenshot=None, size=(1024, 768)):
+    """Register arbitrary per-vertex / per-face scalar fields (errors, indicators, ...).
+
+    Parameters
+    ----------
+    fields : dict, quantity name -> (#V,) or (#F,) array_like (the location is
+        taken from the length; a mesh with #V == #F takes vertices).
+    enabled : quantity name shown first (default: the first one).
+    shared_range : bool, one colour range for all fields (else one each).
+    symmetric, robust, cmap : colour range and map (:func:`color_range`).
+    offset : (3,) translation of the structure (to lay out several pictures).
+
+    Returns
+    -------
+    Registration; ``ranges`` keyed by quantity name.
+    """
+    mesh = as_mesh(V, F)
+    if not isinstance(fields, dict) or not fields:
+        raise TypeError("fields must be a non-empty dict: quantity name -> (#V,) or (#F,) values")
+    vals, where = {}, {}
+    for k, x in fields.items():
+        x = np.asarray(x, dtype=np.float64)
+        if x.shape == (mesh.n_vertices,):
+            where[k] = "vertices"
+        elif x.shape == (mesh.n_faces,):
+            where[k] = "faces"
+        else:
+            raise ValueError(f"field {k!r} has shape {x.shape}; expected ({mesh.n_vertices},) per vertex "
+                             f"or ({mesh.n_faces},) per face")
+        vals[k] = x
+    enabled = next(iter(vals)) if enabled is None else enabled
+    _check(enabled, "enabled", tuple(vals))
+    Vs = mesh.V if offset is None else mesh.V + np.asarray(offset, dtype=np.float64).reshape(3)
+    ps = _polyscope_for(screenshot)
+    reg = Registration()
+    common = color_range(*vals.values(), symmetric=symmetric, robust=robust) if shared_range else None
+    _surface(ps, reg, name, Vs, mesh.F)
+    for k, x in vals.items():
+        reg.ranges[k] = common or color_range(x, symmetric=symmetric, robust=robust)
+        _scalar(reg, name, k, x, where[k], reg.ranges[k], cmap, enabled=(k == enabled))
+    return _finish(reg, screenshot, size)
+
+
+def merge(*registrations):
+    """One :class:`Registration` holding several (e.g. to screenshot them together)."""
+    out = Registration()
+    for r in registrations:
+        out.structures.update(r.structures)
+        out.quantities.update(r.quantities)
+        out.ranges.update(r.ranges)
+        if r.bounds is not None:
+            out.bounds = r.bounds if out.bounds is None else np.stack(
+                [np.minimum(out.bounds[0], r.bounds[0]), np.maximum(out.bounds[1], r.bounds[1])])
+    return out
+
+
 # --------------------------------------------------------------------------- rendering
 def _render(reg, path, size):
     """Write a PNG of the structures of ``reg`` (others hidden during the shot)."""
@@ -648,8 +705,9 @@ def screenshot(path, registration=None, *, size=(1024, 768)):
     Parameters
     ----------
     path : str or path-like, the PNG to write (its directory must exist).
-    registration : Registration, optional: only its structures are drawn
-        (everything registered through this module otherwise).
+    registration : Registration or list of them, optional: only their
+        structures are drawn (everything registered through this module
+        otherwise).
     size : (width, height) in pixels.
 
     Returns
@@ -663,4 +721,6 @@ def screenshot(path, registration=None, *, size=(1024, 768)):
     """
     if registration is None:
         registration = Registration(structures=dict(_REGISTERED))
+    elif isinstance(registration, (list, tuple)):
+        registration = merge(*registration)
     return _render(registration, path, size)
