@@ -54,7 +54,7 @@ LABELS = {"k1": "kappa1", "k2": "kappa2", "H": "mean H", "K": "Gauss K"}
 _TAG = {"hhj": "HHJ", "igl": "libigl", "heine": "Heine"}
 _EGL_HINT = ("headless rendering needs EGL: on Debian/Ubuntu `apt-get install libegl1 libegl-mesa0 "
              "libgl1-mesa-dri`")
-_REGISTERED = {}  # structure name -> polyscope structure, everything this module registered
+_REGISTERED = set()  # names of the structures this module registered (they may since be removed)
 
 
 class ViewerUnavailable(RuntimeError):
@@ -245,12 +245,12 @@ def _surface(ps, reg, name, V, F):
     """Register a surface mesh under ``name``, replacing one of the same name."""
     if ps.has_surface_mesh(name):
         ps.remove_surface_mesh(name)
-    s = ps.register_surface_mesh(name, V, F)
+    s = ps.register_surface_mesh(name, V, F, color=(0.75, 0.75, 0.75))  # grey: no quantity shown
     reg.structures[name] = s
     box = np.stack([V.min(axis=0), V.max(axis=0)])
     reg.bounds = box if reg.bounds is None else np.stack([np.minimum(reg.bounds[0], box[0]),
                                                           np.maximum(reg.bounds[1], box[1])])
-    _REGISTERED[name] = s
+    _REGISTERED.add(name)
     return s
 
 
@@ -349,6 +349,7 @@ def register_curvature(V, F, estimate=None, *, method="hhj", per="both", name="m
     if enabled is not None:
         _check(enabled, "enabled", QUANTITIES)
     mesh = as_mesh(V, F)
+    _check_screenshot(screenshot, size)
     if estimate is None:
         _check(per, "per", ("face", "vertex", "both"))
         pers = ("face", "vertex") if per == "both" else (per,)
@@ -420,6 +421,7 @@ def register_comparison(V, F, *, hhj=None, libigl=None, per="face", layout="copy
         _check(enabled, "enabled", QUANTITIES)
     _check(layout, "layout", ("copy", "quantities"))
     mesh = as_mesh(V, F)
+    _check_screenshot(screenshot, size)
     if hhj is None:
         hhj = curvature_estimate(mesh.V, mesh.F, method="hhj", per=per)
     if libigl is None:
@@ -471,6 +473,7 @@ def register_hessian(V, F, w, *, boundary_gradient=None, name="mesh", label="w",
     from .curvature import principal_from_shape_operator, surface_hessian
     _check(enabled, "enabled", ("w", "lambda1", "lambda2", "trace", "norm"))
     mesh = as_mesh(V, F)
+    _check_screenshot(screenshot, size)
     wv = w(mesh.V.copy()) if callable(w) else w
     wv = np.asarray(wv, dtype=np.float64)
     if wv.shape != (mesh.n_vertices,):
@@ -522,6 +525,7 @@ def register_biharmonic(V, F, u1, u2=None, *, exact=None, f=None, name="mesh", e
     Registration; ``ranges`` keys among "u1", "u2", "f", "error" (u shares u1's).
     """
     mesh = as_mesh(V, F)
+    _check_screenshot(screenshot, size)
     n = mesh.n_vertices
 
     def vertex_values(x, what):
@@ -582,6 +586,7 @@ def register_regge_curvature(V, F, *, boundary="natural", mass="consistent", com
     from .regge import gauss_curvature
     _check(enabled, "enabled", ("K_h", "angle_defect", "hhj") if compare else ("K_h",))
     mesh = as_mesh(V, F)
+    _check_screenshot(screenshot, size)
     Kh = gauss_curvature(mesh.V, mesh.F, boundary=boundary, mass=mass)
     fields = {"K_h": ("Regge K_h (vertices)", Kh, "vertices")}
     if compare:
@@ -621,6 +626,7 @@ def register_scalars(V, F, fields, *, name="mesh", enabled=None, shared_range=Fa
     Registration; ``ranges`` keyed by quantity name.
     """
     mesh = as_mesh(V, F)
+    _check_screenshot(screenshot, size)
     if not isinstance(fields, dict) or not fields:
         raise TypeError("fields must be a non-empty dict: quantity name -> (#V,) or (#F,) values")
     vals, where = {}, {}
@@ -661,28 +667,45 @@ def merge(*registrations):
 
 
 # --------------------------------------------------------------------------- rendering
-def _render(reg, path, size):
-    """Write a PNG of the structures of ``reg`` (others hidden during the shot)."""
+def _check_screenshot(path, size):
+    """Fail fast (before any computation) on an unwritable PNG path or a bad size."""
+    if path is None:
+        return None
     path = os.fspath(path)
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):
         raise ValueError(f"cannot write screenshot {path!r}: directory {folder!r} does not exist")
     if not os.access(folder, os.W_OK):
         raise ValueError(f"cannot write screenshot {path!r}: directory {folder!r} is not writable")
-    w, h = (int(x) for x in size)
+    try:
+        w, h = (int(x) for x in size)
+    except (TypeError, ValueError):
+        raise ValueError(f"size must be (width, height) in pixels, got {size!r}") from None
     if w < 16 or h < 16:
         raise ValueError(f"screenshot size must be at least 16 x 16 pixels, got {size!r}")
+    return path
+
+
+def _render(reg, path, size):
+    """Write a PNG of the structures of ``reg`` (others hidden during the shot)."""
+    path = _check_screenshot(path, size)
+    w, h = (int(x) for x in size)
     import polyscope as ps
     if not ps.is_initialized() or _backend_name(ps) == "openGL_mock":
         raise ViewerUnavailable("polyscope's mock backend draws nothing; register with screenshot=... "
                                 "(which starts the EGL backend) or call viewer.init('openGL3_egl') first")
     ps.set_window_size(w, h)
     ps.set_ground_plane_mode("none")
-    hidden = [s for n, s in _REGISTERED.items() if n not in reg.structures and s.is_enabled()]
+    # look structures up by name: a Python handle of a removed structure must never be touched
+    missing = [n for n in reg.structures if not ps.has_surface_mesh(n)]
+    if missing:
+        raise ValueError(f"cannot render: structure(s) {missing} are no longer registered in polyscope")
+    others = (ps.get_surface_mesh(n) for n in sorted(_REGISTERED - set(reg.structures)) if ps.has_surface_mesh(n))
+    hidden = [s for s in others if s.is_enabled()]
     for s in hidden:
         s.set_enabled(False)
-    for s in reg.structures.values():
-        s.set_enabled(True)
+    for n in reg.structures:
+        ps.get_surface_mesh(n).set_enabled(True)
     try:
         if reg.bounds is not None:
             # frame only this call's structures (hidden ones still count in polyscope's extents)
@@ -720,7 +743,8 @@ def screenshot(path, registration=None, *, size=(1024, 768)):
     ValueError : unwritable path or bad size.
     """
     if registration is None:
-        registration = Registration(structures=dict(_REGISTERED))
+        import polyscope as ps
+        registration = Registration(structures={n: None for n in _REGISTERED if ps.has_surface_mesh(n)})
     elif isinstance(registration, (list, tuple)):
         registration = merge(*registration)
     return _render(registration, path, size)

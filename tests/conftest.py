@@ -48,3 +48,40 @@ def sequence(name, levels):
 
 def rng(seed=0):
     return np.random.default_rng(seed)
+
+
+@functools.cache
+def _egl_probe():
+    """(ok, message): can polyscope open its headless EGL backend?  Probed in a
+    subprocess, because a failed init can leave polyscope unusable in-process."""
+    import subprocess
+    import sys
+    code = "import polyscope as ps; ps.init('openGL3_egl')"
+    try:
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    except subprocess.TimeoutExpired:
+        return False, "EGL probe timed out"
+    return out.returncode == 0, (out.stderr.strip().splitlines() or ["?"])[-1]
+
+
+def require_egl():
+    """Skip when EGL is missing and $CI is unset; in CI a missing EGL is a failure."""
+    import os
+    ok, msg = _egl_probe()
+    if ok:
+        return
+    if os.environ.get("CI"):
+        pytest.fail(f"CI is set but polyscope cannot open EGL (install libegl1 libegl-mesa0 "
+                    f"libgl1-mesa-dri): {msg}")
+    pytest.skip(f"no EGL for headless rendering: {msg}")
+
+
+def png_stats(path):
+    """(height, width, std of RGB, fraction of non-white pixels, fraction of reddish,
+    fraction of bluish pixels) of a PNG screenshot."""
+    import matplotlib.image as mpimg
+    im = mpimg.imread(str(path))[..., :3].astype(np.float64)
+    r, g, b = im[..., 0], im[..., 1], im[..., 2]
+    fg = im.min(axis=2) < 0.97
+    return {"height": im.shape[0], "width": im.shape[1], "std": float(im.std()), "foreground": float(fg.mean()),
+            "red": float(((r > b + 0.15) & fg).mean()), "blue": float(((b > r + 0.15) & fg).mean())}

@@ -1,47 +1,260 @@
-"""igl_hhj.viewer: registration only (polyscope's mock backend, no display)."""
+"""igl_hhj.viewer: registration (polyscope's mock backend) and real headless renders (EGL).
+
+The mock tests check what is registered (names, element counts, colour
+ranges) both in the returned Registration and in polyscope's own buffers.
+The render tests draw with ``openGL3_egl`` and check the PNG: requested size,
+not blank, and coloured by the quantity (the structures are grey without one).
+They skip only when EGL is missing and ``$CI`` is unset (conftest.require_egl).
+"""
 import numpy as np
 import pytest
 
-from igl_hhj.surfaces.meshing import ellipsoid_coarse
+from conftest import png_stats, require_egl
+from igl_hhj.surfaces.exact import Ellipsoid, Sphere
+from igl_hhj.surfaces.meshing import ellipsoid_coarse, icosphere, jitter_tangentially, refine
 
 ps = pytest.importorskip("polyscope")
 
 from igl_hhj import viewer  # noqa: E402
 
+CURV = ("kappa1", "kappa2", "mean H", "Gauss K")
+
 
 @pytest.fixture(scope="module")
+def ellipsoid():
+    s = Ellipsoid()
+    V, F = ellipsoid_coarse(s, subdivisions=1)
+    return refine(V, F, s, 2)
+
+
+@pytest.fixture(scope="module")
+def sphere():
+    s = Sphere()
+    V, F = icosphere(3)
+    return jitter_tangentially(V, F, s, 0.2, seed=3), F
+
+
+@pytest.fixture
 def mock():
-    if not ps.is_initialized():
-        ps.init("openGL_mock")
+    viewer.init("openGL_mock")
     yield ps
     ps.remove_all_structures()
 
 
-def test_register_comparison(mock):
-    V, F = ellipsoid_coarse(subdivisions=2)
-    reg = viewer.register_comparison(V, F, name="ell", enabled="k2")
-    assert ps.has_surface_mesh("ell HHJ") and ps.has_surface_mesh("ell libigl")
-    assert set(reg["ranges"]) == {"k1", "k2", "H", "K"}
-    for lo, hi in reg["ranges"].values():
-        assert lo < hi
-    # the libigl copy is shifted so the two do not overlap
-    lo, hi = reg["ranges"]["K"]
-    assert lo < 0 or lo > 0  # a real range, not the fallback
+@pytest.fixture
+def egl():
+    require_egl()
+    viewer.init("openGL3_egl")
+    yield ps
+    ps.remove_all_structures()
 
 
-def test_shared_range():
-    assert viewer.shared_range(np.array([1.0, 2.0]), np.array([3.0]), percentile=0) == (1.0, 3.0)
-    assert viewer.shared_range(np.array([-1.0, 2.0]), percentile=0) == (-2.0, 2.0)
-    assert viewer.shared_range(np.array([np.nan])) == (-1.0, 1.0)
+def _buffer_size(sname, qname):
+    return ps.get_surface_mesh(sname).get_quantity_buffer(qname, "values").size()
 
 
-def test_bad_input(mock):
-    V, F = ellipsoid_coarse(subdivisions=1)
+# --------------------------------------------------------------------------- registration (mock)
+def test_register_curvature_faces_and_vertices(mock, ellipsoid):
+    V, F = ellipsoid
+    reg = viewer.register_curvature(V, F, name="ell", enabled="k2")
+    assert list(reg.structures) == ["ell"] and ps.has_surface_mesh("ell")
+    for lab in CURV:
+        for where, n in (("faces", len(F)), ("vertices", len(V))):
+            info = reg.quantities[("ell", f"{lab} (HHJ {where})")]
+            assert info.kind == "scalar" and info.defined_on == where and info.values.shape == (n,)
+            assert _buffer_size("ell", f"{lab} (HHJ {where})") == n
+    # the face and vertex values of one curvature share one symmetric range that contains them all
+    for q, lab in zip(viewer.QUANTITIES, CURV):
+        lo, hi = reg.ranges[q]
+        assert lo == -hi > -np.inf and hi > 0
+        for where in ("faces", "vertices"):
+            info = reg.quantities[("ell", f"{lab} (HHJ {where})")]
+            assert info.vminmax == (lo, hi)
+            assert np.nanmax(np.abs(info.values)) == pytest.approx(hi, rel=1e-12) or \
+                np.nanmax(np.abs(info.values)) < hi
+    assert max(np.nanmax(np.abs(reg.quantities[("ell", f"kappa1 (HHJ {w})")].values))
+               for w in ("faces", "vertices")) == pytest.approx(reg.ranges["k1"][1])
+    enabled = [k for k, q in reg.quantities.items() if q.enabled]
+    assert enabled == [("ell", "kappa2 (HHJ faces)")]
+
+
+def test_directions_are_tangent_and_scaled_by_local_edge_length(mock, ellipsoid):
+    V, F = ellipsoid
+    reg = viewer.register_curvature(V, F, name="ell", per="face", direction_scale=0.4)
+    from igl_hhj.mesh import TriangleMesh
+    mesh = TriangleMesh(V, F)
+    lf = viewer.local_edge_length(mesh, "face")
+    for lab in ("PD1", "PD2"):
+        d = reg.quantities[("ell", f"{lab} (HHJ faces)")]
+        assert d.kind == "vector" and d.values.shape == (len(F), 3)
+        np.testing.assert_allclose(np.linalg.norm(d.values, axis=1), 0.4 * lf, rtol=1e-10)
+        assert np.abs(np.einsum("ij,ij->i", d.values, mesh.face_normals)).max() < 1e-10 * lf.max()
+    lv = viewer.local_edge_length(mesh, "vertex")
+    assert lv.shape == (len(V),) and lv.min() > 0
+    # a vertex's mean incident edge length lies between its shortest and longest incident edge
+    assert lv.max() <= mesh.unique_edge_lengths.max() and lv.min() >= mesh.unique_edge_lengths.min()
+
+
+def test_register_curvature_methods_and_robust_range(mock, ellipsoid):
+    V, F = ellipsoid
+    full = viewer.register_curvature(V, F, method="igl", name="igl")
+    assert {q for _, q in full.quantities} >= {f"{lab} (libigl vertices)" for lab in CURV}
+    assert all(q.defined_on == "vertices" for q in full.quantities.values())
+    rob = viewer.register_curvature(V, F, method="heine", name="heine", robust=10, symmetric=False)
+    k1 = rob.quantities[("heine", "kappa1 (Heine vertices)")].values
+    assert rob.ranges["k1"] == pytest.approx(tuple(np.nanpercentile(k1, [10, 90])))
+    est = viewer.curvature_estimate(V, F, method="hhj", per="vertex")
+    pre = viewer.register_curvature(V, F, est, name="pre", ranges={"H": (-9.0, 9.0)})
+    assert pre.quantities[("pre", "mean H (HHJ vertices)")].vminmax == (-9.0, 9.0)
+
+
+def test_register_comparison_shares_ranges(mock, ellipsoid):
+    V, F = ellipsoid
+    reg = viewer.register_comparison(V, F, name="cmp", enabled="K")
+    assert set(reg.structures) == {"cmp HHJ", "cmp libigl"}
+    for q, lab in zip(viewer.QUANTITIES, CURV):
+        a = reg.quantities[("cmp HHJ", f"{lab} (HHJ faces)")]
+        b = reg.quantities[("cmp libigl", f"{lab} (libigl vertices)")]
+        assert a.vminmax == b.vminmax == reg.ranges[q]
+        assert reg.ranges[q] == viewer.color_range(a.values, b.values)
+    assert _buffer_size("cmp libigl", "Gauss K (libigl vertices)") == len(V)
+    # the libigl copy is translated along x so the two do not overlap
+    width = V[:, 0].max() - V[:, 0].min()
+    assert reg.bounds[1, 0] - reg.bounds[0, 0] == pytest.approx(2.15 * width)
+    one = viewer.register_comparison(V, F, name="both", layout="quantities")
+    assert list(one.structures) == ["both"] and len(one.names("both")) == 12  # 2 × (4 scalars + 2 directions)
+
+
+def test_register_hessian_biharmonic_regge_scalars(mock, sphere):
+    V, F = sphere
+    h = viewer.register_hessian(V, F, lambda X: X[:, 2], name="hess")
+    tr = h.quantities[("hess", "Hess w trace (surface Laplacian)")].values
+    # Δ_Γ z = -2 z on the unit sphere: the face traces correlate with -2 z
+    z = V[F].mean(axis=1)[:, 2]
+    assert np.corrcoef(tr, -2 * z)[0, 1] > 0.95
+    assert h.quantities[("hess", "w")].defined_on == "vertices"
+    assert h.ranges["lambda"][0] == -h.ranges["lambda"][1]
+    u = V[:, 0] ** 2
+    b = viewer.register_biharmonic(V, F, u + 0.01, -u, exact=u, name="bih")
+    assert b.quantities[("bih", "u1 (approx. u)")].vminmax == b.quantities[("bih", "u exact")].vminmax
+    err = b.quantities[("bih", "error u1 - u")]
+    np.testing.assert_allclose(err.values, 0.01)
+    assert err.vminmax[0] == -err.vminmax[1]
+    r = viewer.register_regge_curvature(V, F, name="regge")
+    assert {q for _, q in r.quantities} == {"Regge K_h (vertices)", "angle defect / area (vertices)",
+                                            "HHJ Gauss K (faces)"}
+    assert len({q.vminmax for q in r.quantities.values()}) == 1
+    assert abs(np.nanmedian(r.quantities[("regge", "Regge K_h (vertices)")].values) - 1.0) < 0.05
+    s = viewer.register_scalars(V, F, {"x": V[:, 0], "area": np.ones(len(F))}, name="sc", offset=(3, 0, 0))
+    assert s.quantities[("sc", "x")].defined_on == "vertices"
+    assert s.quantities[("sc", "area")].defined_on == "faces"
+    assert s.bounds[0, 0] == pytest.approx(V[:, 0].min() + 3)
+
+
+def test_color_range():
+    assert viewer.color_range(np.array([1.0, 2.0]), np.array([3.0]), symmetric=False) == (1.0, 3.0)
+    assert viewer.color_range(np.array([1.0, 2.0, 3.0])) == (-3.0, 3.0)
+    assert viewer.color_range(np.array([-1.0, 2.0])) == (-2.0, 2.0)
+    assert viewer.color_range(np.array([np.nan, np.inf])) == (-1.0, 1.0)
+    lo, hi = viewer.color_range(np.zeros(4))
+    assert lo < hi
+    x = np.concatenate([np.linspace(-1, 1, 99), [1e6]])           # one outlier
+    assert viewer.color_range(x)[1] == 1e6
+    assert viewer.color_range(x, robust=2)[1] < 1.5
+
+
+def test_bad_input(mock, ellipsoid, tmp_path):
+    V, F = ellipsoid
+    with pytest.raises(ValueError, match="enabled must be one of"):
+        viewer.register_curvature(V, F, enabled="k3")
     with pytest.raises(ValueError, match="enabled must be one of"):
         viewer.register_comparison(V, F, enabled="k3")
-    with pytest.raises(ValueError, match="quantity must be one of"):
-        viewer.screenshot(V, F, "x.png", quantity="k3")
+    with pytest.raises(ValueError, match="method must be one of"):
+        viewer.register_curvature(V, F, method="cgal")
+    with pytest.raises(ValueError, match="per-vertex curvature only"):
+        viewer.curvature_estimate(V, F, method="igl", per="face")
+    with pytest.raises(ValueError, match="layout must be one of"):
+        viewer.register_comparison(V, F, layout="grid")
+    with pytest.raises(ValueError, match="robust must be a percentile"):
+        viewer.color_range(np.ones(3), robust=60)
+    est = viewer.curvature_estimate(V[:10], F[(F < 10).all(axis=1)], per="face") if (F < 10).all(axis=1).any() \
+        else viewer.curvature_estimate(*ellipsoid_coarse(subdivisions=0), per="face")
+    with pytest.raises(ValueError, match="face values"):
+        viewer.register_curvature(V, F, est)
+    with pytest.raises(ValueError, match="w must have shape"):
+        viewer.register_hessian(V, F, np.ones(3))
+    with pytest.raises(ValueError, match="NaN or inf"):
+        viewer.register_hessian(V, F, np.full(len(V), np.nan))
+    with pytest.raises(ValueError, match="has shape"):
+        viewer.register_scalars(V, F, {"x": np.ones(5)})
+    with pytest.raises(TypeError, match="non-empty dict"):
+        viewer.register_scalars(V, F, {})
+    with pytest.raises(ValueError, match="does not exist"):
+        viewer.register_curvature(V, F, screenshot=tmp_path / "no" / "x.png")
+    with pytest.raises(ValueError, match="at least 16"):
+        viewer.register_curvature(V, F, screenshot=tmp_path / "x.png", size=(4, 4))
+    assert viewer.init("auto").get_render_engine_backend_name() == "openGL_mock"  # the checks ran first
+    with pytest.raises(viewer.ViewerUnavailable, match="mock backend draws nothing"):
+        viewer.screenshot(tmp_path / "x.png")
     Fb = F.copy()
     Fb[0, 0] = -1
     with pytest.raises(ValueError, match="negative vertex indices"):
         viewer.register_comparison(V, Fb)
+
+
+# --------------------------------------------------------------------------- headless renders (EGL)
+def _check_png(path, size, *, red=True, blue=False):
+    st = png_stats(path)
+    assert (st["width"], st["height"]) == tuple(size)
+    assert st["std"] > 0.05 and 0.05 < st["foreground"] < 0.95, st      # not blank, object in frame
+    if red:
+        assert st["red"] > 0.01, st          # coloured by the (coolwarm) quantity, not the grey mesh
+    if blue:
+        assert st["blue"] > 0.01, st
+    return st
+
+
+def test_render_curvature(egl, ellipsoid, tmp_path):
+    V, F = ellipsoid
+    reg = viewer.register_curvature(V, F, screenshot=tmp_path / "c.png", size=(320, 240))
+    assert reg.screenshot == str(tmp_path / "c.png")
+    _check_png(tmp_path / "c.png", (320, 240))
+    # the same structure name again with another quantity enabled is still coloured
+    viewer.register_curvature(V, F, enabled="k1", screenshot=tmp_path / "c2.png", size=(320, 240))
+    _check_png(tmp_path / "c2.png", (320, 240))
+
+
+def test_render_comparison(egl, ellipsoid, tmp_path):
+    V, F = ellipsoid
+    viewer.register_comparison(V, F, enabled="H", robust=2, screenshot=tmp_path / "cmp.png", size=(480, 240))
+    st = _check_png(tmp_path / "cmp.png", (480, 240))
+    assert st["foreground"] > 0.15        # both copies in frame
+
+
+def test_render_hessian(egl, sphere, tmp_path):
+    V, F = sphere
+    viewer.register_hessian(V, F, lambda X: X[:, 0] * X[:, 1], enabled="trace",  # -6xy: both signs
+                            screenshot=tmp_path / "h.png", size=(256, 256))
+    _check_png(tmp_path / "h.png", (256, 256), red=True, blue=True)
+
+
+def test_render_biharmonic(egl, sphere, tmp_path):
+    V, F = sphere
+    viewer.register_biharmonic(V, F, V[:, 0], enabled="u1", screenshot=tmp_path / "b.png", size=(256, 256))
+    _check_png(tmp_path / "b.png", (256, 256), red=True, blue=True)
+
+
+def test_render_regge(egl, ellipsoid, tmp_path):
+    V, F = ellipsoid
+    viewer.register_regge_curvature(V, F, screenshot=tmp_path / "r.png", size=(256, 256))
+    _check_png(tmp_path / "r.png", (256, 256))
+
+
+def test_render_scalars_and_merged_screenshot(egl, sphere, tmp_path):
+    V, F = sphere
+    a = viewer.register_scalars(V, F, {"x": V[:, 0]}, name="left")
+    b = viewer.register_scalars(V, F, {"y": V[:, 1]}, name="right", offset=(2.5, 0, 0))
+    viewer.register_scalars(V, F, {"z": V[:, 2]}, name="not drawn", offset=(0, 0, 50))
+    out = viewer.screenshot(tmp_path / "m.png", [a, b], size=(400, 200))
+    st = _check_png(out, (400, 200), red=True, blue=True)
+    assert st["foreground"] > 0.2         # the far-away third structure did not shrink the framing
