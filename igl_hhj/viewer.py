@@ -27,10 +27,11 @@ same curvature) always share one range.  NaN values (undefined, e.g.
 unreferenced vertices) are shown as 0 and kept as NaN in the
 :class:`Registration`.
 
-Principal directions are vector quantities on faces or vertices, drawn as
-tangent segments whose length is ``direction_scale`` times the local mean edge
-length (``vectortype="ambient"``), so they stay readable on graded meshes.
-Principal directions are lines: their sign is arbitrary.
+Principal directions are line fields (polyscope tangent-vector quantities
+with 2-fold symmetry, ``vectortype="ambient"``) on faces or vertices: a
+principal direction has no sign, so it is drawn as a line, not an arrow, and
+its length is ``direction_scale`` times the local mean edge length so the
+lines stay readable on graded meshes.
 """
 from __future__ import annotations
 
@@ -69,8 +70,8 @@ class QuantityInfo:
     ----------
     values : (n,) or (n, 3) float64, the values as computed (NaN kept).
     defined_on : {"vertices", "faces"}
-    kind : {"scalar", "vector"}
-    vminmax : (lo, hi) colour range of a scalar quantity, None for vectors.
+    kind : {"scalar", "line"} (line: a principal-direction field, values (n, 3))
+    vminmax : (lo, hi) colour range of a scalar quantity, None for line fields.
     cmap : str or None, colour map of a scalar quantity.
     enabled : bool, shown when the picture opens.
     """
@@ -276,22 +277,35 @@ def _add_scalars(reg):
             vminmax=q.vminmax, cmap=q.cmap, enabled=q.enabled)
 
 
-def _vector(reg, sname, qname, vectors, defined_on, enabled=False):
+def _line_field(reg, sname, qname, vectors, normals, defined_on, enabled=False):
+    """A principal-direction field drawn as tangent *lines* (polyscope tangent
+    vectors with 2-fold symmetry): ``vectors`` (n, 3) tangent to ``normals``
+    (n, 3), their length is the drawn length."""
     vectors = np.asarray(vectors, dtype=np.float64)
-    reg.structures[sname].add_vector_quantity(qname, np.nan_to_num(vectors), defined_on=defined_on,
-                                              vectortype="ambient", enabled=bool(enabled))
-    reg.quantities[(sname, qname)] = QuantityInfo(vectors, defined_on, "vector", None)
+    vectors = np.where(np.isfinite(vectors), vectors, 0.0)
+    length = np.linalg.norm(vectors, axis=1)
+    bx = np.zeros_like(vectors)
+    np.divide(vectors, length[:, None], out=bx, where=length[:, None] > 0)
+    bx[length == 0] = (1.0, 0.0, 0.0)
+    by = np.cross(np.asarray(normals, dtype=np.float64), bx)     # tangent frame (bx, by)
+    values = np.stack([length, np.zeros_like(length)], axis=1)
+    reg.structures[sname].add_tangent_vector_quantity(qname, values, bx, by, n_sym=2, defined_on=defined_on,
+                                                      vectortype="ambient", enabled=bool(enabled))
+    reg.quantities[(sname, qname)] = QuantityInfo(vectors, defined_on, "line", None, None, bool(enabled))
 
 
-def _add_estimate(reg, sname, mesh, est, tag, ranges, cmap, directions, direction_scale, enabled=None):
+def _add_estimate(reg, sname, mesh, est, tag, ranges, cmap, directions, direction_scale, enabled=None,
+                  show_directions=False):
     """Scalar (k1, k2, H, K) and direction quantities of one CurvatureEstimate."""
     where = "faces" if est.location == "face" else "vertices"
     for q in QUANTITIES:
         _scalar(reg, sname, _qname(q, tag, est), getattr(est, q), where, ranges[q], cmap, enabled=(q == enabled))
     if directions and est.d1 is not None:
         scale = direction_scale * local_edge_length(mesh, est.location)[:, None]
+        normals = mesh.face_normals if est.location == "face" else mesh.vertex_normals
         for k, lab in (("d1", "PD1"), ("d2", "PD2")):
-            _vector(reg, sname, f"{lab} ({tag} {where})", getattr(est, k) * scale, where)
+            _line_field(reg, sname, f"{lab} ({tag} {where})", getattr(est, k) * scale, normals, where,
+                        enabled=show_directions)
 
 
 def _qname(q, tag, est):
@@ -315,7 +329,7 @@ def _finish(reg, screenshot, size):
 
 # --------------------------------------------------------------------------- curvature
 def register_curvature(V, F, estimate=None, *, method="hhj", per="both", name="mesh", enabled="H",
-                       directions=True, symmetric=True, robust=None, cmap="coolwarm", ranges=None,
+                       directions=True, show_directions=False, symmetric=True, robust=None, cmap="coolwarm", ranges=None,
                        direction_scale=0.5, screenshot=None, size=(1024, 768), **estimator_kwargs):
     """Register a mesh with its curvature: κ1, κ2, H, K (scalars) and principal directions.
 
@@ -331,7 +345,8 @@ def register_curvature(V, F, estimate=None, *, method="hhj", per="both", name="m
         (same colour ranges).  "igl"/"heine" are per vertex.
     name : str, structure name.
     enabled : one of "k1", "k2", "H", "K" or None, quantity shown first.
-    directions : bool, register PD1/PD2 vector quantities.
+    directions : bool, register the PD1/PD2 line fields.
+    show_directions : bool, display them when the picture opens (screenshots).
     symmetric, robust : colour range (:func:`color_range`), shared by all
         values of one quantity.
     cmap : polyscope colour map name (diverging by default).
@@ -370,7 +385,7 @@ def register_curvature(V, F, estimate=None, *, method="hhj", per="both", name="m
     _surface(ps, reg, name, mesh.V, mesh.F)
     for i, (est, tag) in enumerate(zip(ests, tags)):
         _add_estimate(reg, name, mesh, est, tag, reg.ranges, cmap, directions, direction_scale,
-                      enabled=enabled if i == 0 else None)
+                      enabled=enabled if i == 0 else None, show_directions=show_directions and i == 0)
     return _finish(reg, screenshot, size)
 
 
@@ -394,7 +409,7 @@ def _check_sizes(mesh, ests):
 
 
 def register_comparison(V, F, *, hhj=None, libigl=None, per="face", layout="copy", name="mesh", enabled="H",
-                        directions=True, symmetric=True, robust=None, cmap="coolwarm", offset=None,
+                        directions=True, show_directions=False, symmetric=True, robust=None, cmap="coolwarm", offset=None,
                         direction_scale=0.5, radius=5, screenshot=None, size=(1600, 800)):
     """HHJ curvature beside ``igl.principal_curvature`` on the same mesh, identical colour ranges.
 
@@ -442,9 +457,10 @@ def register_comparison(V, F, *, hhj=None, libigl=None, per="face", layout="copy
     else:
         sh = si = name
         _surface(ps, reg, name, mesh.V, mesh.F)
-    _add_estimate(reg, sh, mesh, hhj, "HHJ", reg.ranges, cmap, directions, direction_scale, enabled=enabled)
+    _add_estimate(reg, sh, mesh, hhj, "HHJ", reg.ranges, cmap, directions, direction_scale, enabled=enabled,
+                  show_directions=show_directions)
     _add_estimate(reg, si, mesh, libigl, "libigl", reg.ranges, cmap, directions, direction_scale,
-                  enabled=enabled if layout == "copy" else None)
+                  enabled=enabled if layout == "copy" else None, show_directions=show_directions and layout == "copy")
     return _finish(reg, screenshot, size)
 
 
@@ -501,8 +517,8 @@ def register_hessian(V, F, w, *, boundary_gradient=None, name="mesh", label="w",
         _scalar(reg, name, names[key], vals, where, reg.ranges[rng], cm, enabled=(key == enabled))
     if directions:
         scale = direction_scale * local_edge_length(mesh, "face")[:, None]
-        _vector(reg, name, f"Hess {label} dir1", d1 * scale, "faces")
-        _vector(reg, name, f"Hess {label} dir2", d2 * scale, "faces")
+        _line_field(reg, name, f"Hess {label} dir1", d1 * scale, mesh.face_normals, "faces")
+        _line_field(reg, name, f"Hess {label} dir2", d2 * scale, mesh.face_normals, "faces")
     return _finish(reg, screenshot, size)
 
 

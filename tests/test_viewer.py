@@ -80,13 +80,13 @@ def test_register_curvature_faces_and_vertices(mock, ellipsoid):
 
 def test_directions_are_tangent_and_scaled_by_local_edge_length(mock, ellipsoid):
     V, F = ellipsoid
-    reg = viewer.register_curvature(V, F, name="ell", per="face", direction_scale=0.4)
+    reg = viewer.register_curvature(V, F, name="ell", per="face", direction_scale=0.4, show_directions=True)
     from igl_hhj.mesh import TriangleMesh
     mesh = TriangleMesh(V, F)
     lf = viewer.local_edge_length(mesh, "face")
     for lab in ("PD1", "PD2"):
         d = reg.quantities[("ell", f"{lab} (HHJ faces)")]
-        assert d.kind == "vector" and d.values.shape == (len(F), 3)
+        assert d.kind == "line" and d.values.shape == (len(F), 3) and d.enabled
         np.testing.assert_allclose(np.linalg.norm(d.values, axis=1), 0.4 * lf, rtol=1e-10)
         assert np.abs(np.einsum("ij,ij->i", d.values, mesh.face_normals)).max() < 1e-10 * lf.max()
     lv = viewer.local_edge_length(mesh, "vertex")
