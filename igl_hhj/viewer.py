@@ -140,17 +140,42 @@ def init(backend="auto"):
             return ps
         ps.shutdown()
         _REGISTERED.clear()
+    # Without this a failed backend (e.g. EGL libraries missing) crashes the interpreter.
+    ps.set_errors_throw_exceptions(True)
     try:
         ps.init(backend)
     except Exception as exc:
+        _reset_after_failed_init(ps)
         hint = f"; {_EGL_HINT}" if "egl" in backend.lower() else ""
-        raise ViewerUnavailable(f"polyscope could not initialise backend {backend!r}: {exc}{hint}") from exc
+        raise ViewerUnavailable(f"polyscope could not initialise backend {backend!r}: "
+                                f"{str(exc).replace('[polyscope] ', '')}{hint}") from None
     return ps
 
 
+def _reset_after_failed_init(ps):
+    """Leave polyscope cleanly uninitialised (its exit hook fails on a half-initialised state)."""
+    try:
+        ps.set_verbosity(0)
+        ps.init("openGL_mock")
+        ps.shutdown()
+        ps.set_verbosity(2)
+    except Exception:  # pragma: no cover - nothing more to do
+        pass
+
+
 def show():
-    """Open polyscope's interactive window on everything registered (needs a display)."""
-    init("auto").show()
+    """Open polyscope's interactive window on everything registered (needs a display).
+
+    Raises
+    ------
+    ViewerUnavailable : polyscope runs a backend without a window (mock, EGL)
+        or cannot open one.
+    """
+    ps = init("auto")
+    if _backend_name(ps) in ("openGL_mock", "openGL3_egl"):
+        raise ViewerUnavailable(f"polyscope is running the windowless {_backend_name(ps)!r} backend; "
+                                "use screenshot=... or run with a display")
+    ps.show()
 
 
 # --------------------------------------------------------------------------- values

@@ -6,6 +6,9 @@ The render tests draw with ``openGL3_egl`` and check the PNG: requested size,
 not blank, and coloured by the quantity (the structures are grey without one).
 They skip only when EGL is missing and ``$CI`` is unset (conftest.require_egl).
 """
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -258,3 +261,26 @@ def test_render_scalars_and_merged_screenshot(egl, sphere, tmp_path):
     out = viewer.screenshot(tmp_path / "m.png", [a, b], size=(400, 200))
     st = _check_png(out, (400, 200), red=True, blue=True)
     assert st["foreground"] > 0.2         # the far-away third structure did not shrink the framing
+
+
+def test_missing_egl_is_a_clear_error_not_a_crash(tmp_path):
+    """Without usable EGL libraries polyscope used to segfault the interpreter; the
+    viewer must raise ViewerUnavailable naming the Debian packages, and the process
+    must stay usable and exit cleanly."""
+    for lib in ("libEGL.so", "libEGL.so.1"):
+        (tmp_path / lib).write_bytes(b"")          # shadows the real library: dlopen fails
+    code = ("from igl_hhj import viewer\n"
+            "from igl_hhj.surfaces.meshing import ellipsoid_coarse\n"
+            "V, F = ellipsoid_coarse(subdivisions=1)\n"
+            "for _ in range(2):\n"
+            "    try:\n"
+            f"        viewer.register_curvature(V, F, screenshot={str(tmp_path / 'x.png')!r})\n"
+            "    except viewer.ViewerUnavailable as exc:\n"
+            "        print('UNAVAILABLE', exc)\n"
+            "viewer.init('openGL_mock'); viewer.register_curvature(V, F); print('STILL USABLE')\n")
+    env = dict(__import__("os").environ, LD_LIBRARY_PATH=str(tmp_path))
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.count("UNAVAILABLE") == 2 and "libegl1 libegl-mesa0 libgl1-mesa-dri" in out.stdout
+    assert "STILL USABLE" in out.stdout and "Exception ignored" not in out.stderr
+    assert not (tmp_path / "x.png").exists()
