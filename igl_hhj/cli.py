@@ -1,13 +1,117 @@
-"""Command-line interface: ``igl-hhj demo`` and ``igl-hhj curvature MESH``."""
+"""The ``igl-hhj`` command line (also ``python -m igl_hhj.cli``).
+
+Commands
+--------
+``igl-hhj demo``
+    HHJ vs libigl curvature errors on a jittered ellipsoid sequence, then a
+    screenshot of the finest mesh (headless; skipped with a warning when EGL
+    is missing).
+``igl-hhj curvature MESH``
+    principal curvatures and directions, mean and Gauss curvature of a mesh
+    file, written to ``.npz``, ``.csv`` or ``.ply``; optional polyscope view
+    or screenshot.
+``igl-hhj info MESH``
+    what the mesh is made of and whether igl_hhj accepts it.
+
+Exit codes
+----------
+0 success; 1 ``info``: the file was read but igl_hhj rejects the mesh;
+2 user error (missing / unreadable / malformed file, a mesh igl_hhj rejects in
+``curvature``, bad options, unwritable output, viewer unavailable for
+``--view`` / ``--screenshot``).  User errors print exactly one line
+``igl-hhj: error: ...`` on stderr; programming errors raise.
+"""
 from __future__ import annotations
 
 import argparse
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
+EGL_HINT = ("headless rendering needs EGL; on Debian/Ubuntu: "
+            "apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri")
+LARGE_MESH_FACES = 100_000
+"""Meshes with more faces get stage-by-stage progress lines on stderr."""
 
+# (method, per) -> igl_hhj.baselines estimator
+ESTIMATORS = {("hhj", "vertex"): "hhj_vertex", ("hhj", "face"): "hhj_face",
+              ("igl", "vertex"): "libigl_quadric", ("heine", "vertex"): "heine"}
+METHOD_LABELS = {"hhj": "HHJ solve", "igl": "libigl quadric fit", "heine": "Heine P1 solve"}
+
+
+class UserError(Exception):
+    """A problem with the user's input: printed as one line, exit code ``code``."""
+
+    def __init__(self, message, code=2):
+        super().__init__(message)
+        self.code = code
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (argparse prints usage + error = two lines)."""
+
+    def error(self, message):
+        raise UserError(f"{message} (see '{self.prog} --help')")
+
+
+class _Stages:
+    """``[i/n] label ... t s`` lines on stderr, only when enabled (large meshes)."""
+
+    def __init__(self, total, enabled):
+        self.total, self.enabled, self.i = total, enabled, 0
+
+    def done(self, label, seconds):
+        """Report a stage that has already finished."""
+        self.i += 1
+        if self.enabled:
+            print(f"[{self.i}/{self.total}] {label} ... {seconds:.1f} s", file=sys.stderr, flush=True)
+
+    def run(self, label, fn, *args, **kwargs):
+        self.i += 1
+        if self.enabled:
+            print(f"[{self.i}/{self.total}] {label} ...", end=" ", file=sys.stderr, flush=True)
+        t = time.perf_counter()
+        out = fn(*args, **kwargs)
+        if self.enabled:
+            print(f"{time.perf_counter() - t:.1f} s", file=sys.stderr, flush=True)
+        return out
+
+
+def _read(path):
+    """Guarded read; libigl's warnings become one warning line."""
+    from .mesh_io import MeshFileError, read_mesh
+    try:
+        V, F, messages = read_mesh(path)
+    except MeshFileError as exc:
+        raise UserError(str(exc)) from None
+    if messages:
+        more = f" (+{len(messages) - 2} more)" if len(messages) > 2 else ""
+        print(f"igl-hhj: warning: {path}: " + "; ".join(messages[:2]) + more, file=sys.stderr)
+    return V, F
+
+
+def _check_writable(path, extensions=None):
+    from .mesh_io import MeshFileError, check_output_path, probe_writable
+    try:
+        if extensions is None:
+            check_output_path(path)
+        else:
+            if Path(path).suffix.lower() not in extensions:
+                raise MeshFileError(f"{path}: unknown image extension {Path(path).suffix!r} "
+                                    f"(use {', '.join(extensions)})")
+            probe_writable(path)
+    except MeshFileError as exc:
+        raise UserError(str(exc)) from None
+
+
+def _viewer():
+    from . import viewer
+    return viewer
+
+
+# --------------------------------------------------------------------------- demo
 def _demo(args):
     import igl
 
@@ -15,6 +119,11 @@ def _demo(args):
     from .convergence import eoc, vertex_errors
     from .surfaces import Ellipsoid, ellipsoid_coarse, mesh_sequence
 
+    if args.levels < 1:
+        raise UserError(f"--levels must be at least 1, got {args.levels}")
+    shot = None if args.no_screenshot else args.screenshot
+    if shot is not None:
+        _check_writable(shot, (".png",))
     surface = Ellipsoid()
     V0, F0 = ellipsoid_coarse(surface, subdivisions=2, amount=0.3, seed=args.seed)
     print("igl_hhj demo: ellipsoid x² + (2y)² + (2z/3)² = 1, jittered coarse mesh refined "
@@ -42,51 +151,174 @@ def _demo(args):
         print("\nEOC (last level):  HHJ  H {:.2f}  K {:.2f}   |   libigl  H {:.2f}  K {:.2f}".format(
             eoc([r[0]["H"] for r in rows], hs)[-1], eoc([r[0]["K"] for r in rows], hs)[-1],
             eoc([r[1]["H"] for r in rows], hs)[-1], eoc([r[1]["K"] for r in rows], hs)[-1]))
+    if shot is not None:
+        viewer = _viewer()
+        try:
+            viewer.register_comparison(V, F, enabled="H", robust=2.0, screenshot=str(shot))
+        except viewer.ViewerUnavailable as exc:
+            print(f"igl-hhj: warning: no screenshot ({_first_line(exc)}); {EGL_HINT}", file=sys.stderr)
+        else:
+            print(f"\nwrote {shot} (mean curvature: HHJ beside libigl on the finest mesh)")
     return 0
 
 
-def _curvature(args):
-    import igl
+def _first_line(exc):
+    text = str(exc).strip().splitlines()
+    return text[0] if text else type(exc).__name__
 
-    from . import principal_curvature, shape_operator
+
+# --------------------------------------------------------------------------- curvature
+def _curvature(args):
+    from . import baselines
     from .mesh import TriangleMesh
 
-    V, F = igl.read_triangle_mesh(args.mesh)
+    per = args.per
+    if args.method != "hhj" and per == "face":
+        raise UserError(f"--method {args.method} computes per-vertex curvature only; "
+                        f"use --per vertex (or --method hhj for per-face values)")
+    if args.out is not None:
+        _check_writable(args.out)
+    if args.screenshot is not None:
+        _check_writable(args.screenshot, (".png",))
+
     t = time.perf_counter()
-    mesh = TriangleMesh(V, F)
-    S = shape_operator(mesh.V, mesh.F)
-    PD1, PD2, PV1, PV2, bad = principal_curvature(mesh.V, mesh.F)
+    V, F = _read(args.mesh)
+    try:
+        mesh = TriangleMesh(V, F)
+    except (ValueError, TypeError) as exc:
+        raise UserError(f"{args.mesh}: igl_hhj cannot use this mesh: {exc} "
+                        f"(run 'igl-hhj info {args.mesh}' for a diagnosis)") from None
+    t_read = time.perf_counter() - t
+    large = mesh.n_faces > LARGE_MESH_FACES and not args.quiet
+    keep_S = args.method == "hhj" and args.out is not None and Path(args.out).suffix.lower() == ".npz"
+    n_stages = 2 + (args.out is not None) + keep_S + (args.screenshot is not None)
+    stages = _Stages(n_stages, large)
+    stages.done(f"reading and validating {mesh.n_faces} faces", t_read)
+
+    t = time.perf_counter()
+    est = stages.run(f"{METHOD_LABELS[args.method]} ({per})",
+                     baselines.estimate, ESTIMATORS[args.method, per], mesh.V, mesh.F)
     dt = time.perf_counter() - t
+
     print(f"{args.mesh}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, "
-          f"{int(mesh.boundary_edges.sum())} boundary edges; {dt:.2f} s")
-    for name, x in [("kappa1", PV1), ("kappa2", PV2), ("mean", 0.5 * (PV1 + PV2)), ("gauss", PV1 * PV2)]:
-        q = np.nanpercentile(x, [1, 50, 99])
-        print(f"  {name:>6}: 1% {q[0]: .4g}   median {q[1]: .4g}   99% {q[2]: .4g}")
-    if bad:
-        print(f"  {len(bad)} unreferenced vertices have no value (NaN)")
-    if args.out:
-        np.savez(args.out, S=S, PD1=PD1, PD2=PD2, PV1=PV1, PV2=PV2)
-        print(f"  wrote {args.out}")
+          f"{int(mesh.boundary_edges.sum())} boundary edges")
+    print(f"  method {args.method} per {per}: {dt:.2f} s")
+    for name, x in [("k1", est.k1), ("k2", est.k2), ("H", est.H), ("K", est.K)]:
+        q = np.nanpercentile(x, [1, 50, 99]) if np.isfinite(x).any() else [np.nan] * 3
+        print(f"  {name:>3}: 1% {q[0]: .4g}   median {q[1]: .4g}   99% {q[2]: .4g}")
+    n_nan = int(np.isnan(est.k1).sum())
+    if n_nan:
+        print(f"  {n_nan} {per}s have no value (NaN): "
+              + ("unreferenced vertices" if args.method == "hhj" else "see the method's 'bad' rows"))
+
+    if args.out is not None:
+        S = None
+        if keep_S:     # the estimators do not return S_h: one more solve for the npz
+            from .curvature import shape_operator
+            S = stages.run("HHJ shape operator S for the npz", shape_operator, mesh.V, mesh.F)
+        _write(stages, args, mesh, est, S)
+
+    if args.screenshot is not None or args.view:
+        viewer = _viewer()
+        name = Path(args.mesh).stem
+        robust = args.robust if args.robust > 0 else None
+        try:
+            if args.view:        # first: the interactive window cannot open after an EGL render
+                viewer.register_curvature(mesh.V, mesh.F, estimate=est, name=name, robust=robust)
+                viewer.show()
+            if args.screenshot is not None:
+                stages.run("screenshot", viewer.register_curvature, mesh.V, mesh.F, estimate=est,
+                           name=name, robust=robust, screenshot=str(args.screenshot))
+                print(f"  wrote {args.screenshot}")
+        except viewer.ViewerUnavailable as exc:
+            raise UserError(f"viewer unavailable: {_first_line(exc)}; {EGL_HINT}") from None
     return 0
+
+
+def _write(stages, args, mesh, est, S):
+    from .mesh_io import write_curvature
+    try:
+        stages.run(f"writing {args.out}", write_curvature, args.out, mesh.V, mesh.F, est,
+                   method=args.method, S=S)
+    except OSError as exc:
+        raise UserError(f"{args.out}: cannot write: {exc.strerror or exc}") from None
+    print(f"  wrote {args.out}")
+
+
+# --------------------------------------------------------------------------- info
+def _info(args):
+    from .mesh_report import mesh_report
+    V, F = _read(args.mesh)
+    report = mesh_report(V, F)
+    print(f"{args.mesh}")
+    for line in report.lines():
+        print(f"  {line}")
+    return 0 if report.accepted else 1
+
+
+# --------------------------------------------------------------------------- main
+def build_parser():
+    parser = _Parser(prog="igl-hhj",
+                     description="igl_hhj: convergent finite-element (HHJ) curvature of triangle meshes.",
+                     epilog="exit codes: 0 ok, 1 info: mesh rejected, 2 user error")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    d = sub.add_parser("demo", help="HHJ vs libigl curvature on a built-in ellipsoid mesh sequence",
+                       description="Error table of HHJ and libigl curvature against the exact ellipsoid, "
+                                   "then a screenshot of the finest mesh.")
+    d.add_argument("--levels", type=int, default=4, help="number of refinement levels (default 4)")
+    d.add_argument("--seed", type=int, default=0, help="seed of the coarse-mesh jitter (default 0)")
+    d.add_argument("--screenshot", default="igl_hhj_demo.png", metavar="PNG",
+                   help="where to write the screenshot (default ./igl_hhj_demo.png)")
+    d.add_argument("--no-screenshot", action="store_true", help="only print the table")
+    d.set_defaults(func=_demo)
+
+    c = sub.add_parser("curvature", help="curvature of a mesh file (any format libigl reads)",
+                       description="Principal curvatures k1 >= k2, directions d1, d2, mean H and "
+                                   "Gauss K curvature of a triangle mesh (.obj .off .ply .stl .wrl "
+                                   ".mesh .msh). Sign: +1/R on a sphere with outward normals.")
+    c.add_argument("mesh", metavar="MESH")
+    c.add_argument("--method", choices=["hhj", "igl", "heine"], default="hhj",
+                   help="hhj: Walker's HHJ shape operator (default); igl: igl.principal_curvature "
+                        "(quadric fit); heine: Heine's P1 Weingarten map (does not converge)")
+    c.add_argument("--per", choices=["face", "vertex"], default="vertex",
+                   help="vertex (default, comparable with libigl) or face (HHJ's native "
+                        "piecewise-constant values; hhj only)")
+    c.add_argument("-o", "--out", metavar="OUT",
+                   help="write k1, k2, H, K, d1, d2 to OUT.npz (+ V, F, and the shape operator S "
+                        "for hhj), OUT.csv or OUT.ply (binary, values as vertex or face properties)")
+    c.add_argument("--view", action="store_true", help="open the polyscope viewer")
+    c.add_argument("--screenshot", metavar="PNG", help="render the curvature headless to PNG")
+    c.add_argument("--robust", type=float, default=1.0, metavar="P",
+                   help="colour range of --view/--screenshot from the P-th to the (100-P)-th "
+                        "percentile (default 1; 0: full range)")
+    c.add_argument("-q", "--quiet", action="store_true",
+                   help=f"no progress lines (printed on stderr for meshes > {LARGE_MESH_FACES} faces)")
+    c.set_defaults(func=_curvature)
+
+    i = sub.add_parser("info", help="mesh statistics and whether igl_hhj accepts the mesh",
+                       description="Vertices, faces, edges, components, boundary loops, Euler "
+                                   "characteristic, genus, manifoldness, orientation, degenerate and "
+                                   "duplicate faces, and igl_hhj's verdict. Exit 0 accepted, "
+                                   "1 rejected, 2 unreadable.")
+    i.add_argument("mesh", metavar="MESH")
+    i.set_defaults(func=_info)
+    return parser
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="igl-hhj", description=__doc__)
-    sub = parser.add_subparsers(dest="command", required=True)
-    d = sub.add_parser("demo", help="HHJ vs libigl curvature on a built-in ellipsoid mesh sequence")
-    d.add_argument("--levels", type=int, default=4, help="number of refinement levels (default 4)")
-    d.add_argument("--seed", type=int, default=0)
-    d.set_defaults(func=_demo)
-    c = sub.add_parser("curvature", help="principal curvatures of a mesh file (any format libigl reads)")
-    c.add_argument("mesh")
-    c.add_argument("--out", help="write S, PD1, PD2, PV1, PV2 to this .npz file")
-    c.set_defaults(func=_curvature)
-    args = parser.parse_args(argv)
+    """Run the command line; returns the exit code (``sys.exit(main())``)."""
     try:
+        args = build_parser().parse_args(argv)
         return args.func(args)
-    except (ValueError, TypeError, OSError) as exc:
+    except UserError as exc:
         print(f"igl-hhj: error: {exc}", file=sys.stderr)
-        return 2
+        return exc.code
+    except SystemExit as exc:                    # --help
+        return exc.code if isinstance(exc.code, int) else 0
+    except KeyboardInterrupt:
+        print("igl-hhj: interrupted", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

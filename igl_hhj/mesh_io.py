@@ -1,0 +1,395 @@
+"""Guarded mesh reading and curvature output files (used by the ``igl-hhj`` command line).
+
+Reading goes through ``igl.read_triangle_mesh``; this module only checks the
+file *before* libigl sees it, because libigl 2.6's readers misbehave on some
+bad inputs instead of raising (measured with libigl 2.6.3):
+
+* a directory or a missing file: C++ messages on stderr (the directory case
+  prints uninitialised memory) and a bare ``RuntimeError``;
+* ``.obj``, ``.ply`` or ``.mesh`` garbage: *no* error, empty arrays;
+* an ascii ``.ply`` with fewer faces than its header declares, or with
+  mixed triangles and quads: ``free(): double free`` — the process aborts;
+* a ``.ply`` header declaring 10¹¹ vertices in a 150-byte file: an endless
+  loop; 10⁸ vertices: 4.7 GB of memory before returning;
+* an ``.off`` header declaring 10⁸ vertices: 5.5 GB of memory, 15 s;
+* a truncated binary ``.ply``: uninitialised memory returned as face indices.
+
+:func:`read_mesh` therefore checks existence, regular file, readability and
+extension, compares the element counts an ``.off`` / ``.ply`` header declares
+with the file size (and, for ``.ply``, that every face is a triangle), reads
+with libigl's C++ messages captured, and raises :class:`MeshFileError` (a
+``ValueError``) with one line naming the problem.
+
+:func:`write_curvature` writes a
+:class:`igl_hhj.baselines.CurvatureEstimate` as ``.npz``, ``.csv`` or
+binary little-endian ``.ply`` (numpy only, no per-element Python loops).
+"""
+from __future__ import annotations
+
+import os
+import re
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["MeshFileError", "MESH_EXTENSIONS", "OUTPUT_EXTENSIONS", "read_mesh",
+           "check_output_path", "probe_writable", "write_curvature", "CURVATURE_COLUMNS"]
+
+MESH_EXTENSIONS = (".obj", ".off", ".ply", ".stl", ".wrl", ".mesh", ".msh")
+"""Extensions ``igl.read_triangle_mesh`` dispatches on (case-insensitive)."""
+
+OUTPUT_EXTENSIONS = (".npz", ".csv", ".ply")
+
+CURVATURE_COLUMNS = ("k1", "k2", "H", "K", "d1x", "d1y", "d1z", "d2x", "d2y", "d2z")
+"""Per-element columns of the ``.csv`` and ``.ply`` outputs (after ``index`` in the csv)."""
+
+_HEADER_BYTES = 1 << 16
+_PLY_SIZES = {"char": 1, "int8": 1, "uchar": 1, "uint8": 1, "short": 2, "int16": 2,
+              "ushort": 2, "uint16": 2, "int": 4, "int32": 4, "uint": 4, "uint32": 4,
+              "float": 4, "float32": 4, "double": 8, "float64": 8}
+
+
+class MeshFileError(ValueError):
+    """A mesh or output file the command line cannot use (message: one line)."""
+
+
+# --------------------------------------------------------------------------- reading
+def _check_input_file(path):
+    path = Path(path)
+    if not path.exists():
+        raise MeshFileError(f"{path}: no such file")
+    if path.is_dir():
+        raise MeshFileError(f"{path}: is a directory, not a mesh file")
+    if not path.is_file():
+        raise MeshFileError(f"{path}: not a regular file")
+    ext = path.suffix.lower()
+    if ext not in MESH_EXTENSIONS:
+        raise MeshFileError(f"{path}: unknown mesh file extension {path.suffix!r} "
+                            f"(libigl reads {', '.join(MESH_EXTENSIONS)})")
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(_HEADER_BYTES)
+    except OSError as exc:
+        raise MeshFileError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    if not head.strip():
+        raise MeshFileError(f"{path}: file is empty")
+    return path, ext, head
+
+
+def _too_short(path, what, need, have):
+    raise MeshFileError(f"{path}: truncated or corrupt: the header declares {what}, which needs "
+                        f"at least {need} bytes after the header, but the file has {have}")
+
+
+def _check_off_header(path, head, size):
+    """Declared ``nV nF`` of an ascii OFF against the file size (≥ 6 bytes a vertex, 8 a face)."""
+    lines = [ln.split(b"#")[0].split() for ln in head.split(b"\n")[:64]]
+    tokens = [t for ln in lines for t in ln]
+    if not tokens or not re.fullmatch(rb"[A-Z]*OFF", tokens[0]):
+        return                                               # libigl reports this itself
+    if b"BINARY" in tokens[:2]:
+        raise MeshFileError(f"{path}: binary OFF is not supported by libigl's reader")
+    try:
+        nV, nF = int(tokens[1]), int(tokens[2])
+    except (IndexError, ValueError):
+        raise MeshFileError(f"{path}: corrupt OFF header: expected the counts '#V #F #E' after "
+                            f"{tokens[0].decode()!r}, got {b' '.join(tokens[1:4]).decode(errors='replace')!r}"
+                            ) from None
+    if nV < 0 or nF < 0:
+        raise MeshFileError(f"{path}: corrupt OFF header: negative counts {nV} {nF}")
+    need = 6 * nV + 8 * nF - 1          # "0 0 0\n" per vertex, "3 0 1 2\n" per face
+    if need > size:
+        _too_short(path, f"{nV} vertices and {nF} faces", need, size)
+
+
+def _parse_ply_header(path, head):
+    end = head.find(b"end_header")
+    if not head.startswith(b"ply") or end < 0:
+        raise MeshFileError(f"{path}: not a PLY file (no 'ply' ... 'end_header' header "
+                            f"in the first {_HEADER_BYTES} bytes)")
+    body_start = head.index(b"\n", end) + 1 if b"\n" in head[end:] else len(head)
+    fmt, elements = None, []
+    for raw in head[:end].split(b"\n")[1:]:
+        w = raw.decode("ascii", "replace").split()
+        if not w or w[0] in ("comment", "obj_info"):
+            continue
+        try:
+            if w[0] == "format":
+                fmt = w[1]
+            elif w[0] == "element":
+                elements.append([w[1], int(w[2]), []])
+            elif w[0] == "property":
+                elements[-1][2].append((w[-1], w[1:-1]))
+        except (IndexError, ValueError):
+            raise MeshFileError(f"{path}: corrupt PLY header line {raw[:60]!r}") from None
+    if fmt not in ("ascii", "binary_little_endian", "binary_big_endian"):
+        raise MeshFileError(f"{path}: unknown PLY format {fmt!r}")
+    if any(n < 0 for _, n, _ in elements):
+        raise MeshFileError(f"{path}: corrupt PLY header: negative element count")
+    return fmt, elements, body_start
+
+
+def _check_ply(path, head, size):
+    """PLY element counts against the body, and triangles only (libigl aborts on mixed polygons)."""
+    fmt, elements, body_start = _parse_ply_header(path, head)
+    body = size - body_start
+    counts = {name: n for name, n, _ in elements}
+    what = "elements " + ", ".join(f"{name} {n}" for name, n, _ in elements)
+    if fmt != "ascii":
+        need, exact = 0, True
+        for name, n, props in elements:
+            rec = 0
+            for pname, types in props:
+                if types[0] == "list":          # list <count type> <item type>
+                    if name != "face" or pname not in ("vertex_indices", "vertex_index"):
+                        exact = False
+                        rec += _PLY_SIZES.get(types[1], 1)
+                    else:                       # a triangle: count + 3 indices
+                        rec += _PLY_SIZES.get(types[1], 1) + 3 * _PLY_SIZES.get(types[2], 4)
+                else:
+                    rec += _PLY_SIZES.get(types[0], 1)
+            need += n * rec
+        if need > body or (exact and need != body):
+            raise MeshFileError(
+                f"{path}: truncated or not a triangle mesh: the header declares {what}, "
+                f"a triangle mesh with those needs {need} body bytes, the file has {body} "
+                f"(libigl's PLY reader crashes or returns garbage on such files)")
+        return
+    # ascii: one line per element; check the count first (bounded memory), then the faces
+    total = sum(counts.values())
+    if 2 * total - 1 > body:
+        _too_short(path, what, 2 * total - 1, body)
+    with open(path, "rb") as fh:
+        fh.seek(body_start)
+        lines = np.array(fh.read().split(b"\n"))
+    lines = lines[np.char.str_len(np.char.strip(lines)) > 0]
+    if len(lines) != total:
+        raise MeshFileError(f"{path}: truncated or corrupt: the header declares {what} "
+                            f"({total} lines) but the body has {len(lines)} lines "
+                            f"(libigl's PLY reader aborts on such files)")
+    start = 0
+    for name, n, _ in elements:
+        if name == "face" and n:
+            face_lines = np.char.strip(np.char.replace(lines[start:start + n], b"\t", b" "))
+            first = np.char.partition(face_lines, b" ")[:, 0]
+            bad = np.flatnonzero(first != b"3")
+            if bad.size:
+                raise MeshFileError(f"{path}: face {int(bad[0])} has {first[bad[0]].decode(errors='replace')} "
+                                    f"vertices: only triangle meshes are supported "
+                                    f"(libigl's PLY reader aborts on mixed polygons)")
+        start += n
+
+
+def _flush_c_stdio():
+    """Flush C stdio buffers (libigl's readers print with printf to a buffered stdout)."""
+    try:
+        import ctypes
+        ctypes.CDLL(None).fflush(None)
+    except (OSError, AttributeError, TypeError):  # no C runtime handle (e.g. Windows)
+        pass
+
+
+class _CapturedOutput:
+    """Redirect file descriptors 1 and 2 (libigl's C/C++ messages) into a temporary file."""
+
+    def __enter__(self):
+        import sys
+        sys.stdout.flush()
+        sys.stderr.flush()
+        _flush_c_stdio()
+        self._tmp = tempfile.TemporaryFile()
+        self._saved = [os.dup(1), os.dup(2)]
+        os.dup2(self._tmp.fileno(), 1)
+        os.dup2(self._tmp.fileno(), 2)
+        return self
+
+    def __exit__(self, *exc):
+        _flush_c_stdio()
+        for fd, saved in zip((1, 2), self._saved):
+            os.dup2(saved, fd)
+            os.close(saved)
+        self._tmp.seek(0)
+        text = self._tmp.read(_HEADER_BYTES).decode("utf-8", "replace")
+        self._tmp.close()
+        lines = [" ".join("".join(c if " " <= c <= "~" else "?" for c in ln).split())
+                 for ln in text.splitlines()[:20]]
+        self.lines = [ln for ln in lines if ln]
+        return False
+
+
+def _libigl_says(lines):
+    if not lines:
+        return ""
+    first = lines[0] if len(lines[0]) <= 120 else lines[0][:117] + "..."
+    return f" (libigl: {first})"
+
+
+def read_mesh(path):
+    """Read a triangle mesh with ``igl.read_triangle_mesh``, guarded.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A file with one of :data:`MESH_EXTENSIONS`.
+
+    Returns
+    -------
+    V : (#V, 3) float64
+    F : (#F, k) int64 as libigl returns it (k = 3 for triangle meshes; not
+        validated further: use :class:`igl_hhj.mesh.TriangleMesh`).
+    messages : list of str
+        What libigl printed while reading (warnings; at most 20 lines), plus a
+        note when coincident ``.stl`` vertices were merged.
+
+    Raises
+    ------
+    MeshFileError
+        Missing / unreadable / empty file, a directory, an unknown extension,
+        a header that does not match the file, a read failure, or a file from
+        which libigl read no faces.
+    """
+    path, ext, head = _check_input_file(path)
+    size = path.stat().st_size
+    if ext == ".off":
+        _check_off_header(path, head, size)
+    elif ext == ".ply":
+        _check_ply(path, head, size)
+    import igl
+    with _CapturedOutput() as cap:
+        try:
+            V, F = igl.read_triangle_mesh(str(path))
+            exc = None
+        except (RuntimeError, ValueError, MemoryError) as e:
+            exc = e
+    if exc is not None:
+        raise MeshFileError(f"{path}: libigl could not read it: {exc}{_libigl_says(cap.lines)}")
+    V = np.asarray(V, dtype=np.float64)
+    F = np.asarray(F)
+    if F.size == 0:
+        raise MeshFileError(f"{path}: libigl read no faces from this {ext} file"
+                            f"{_libigl_says(cap.lines)}")
+    if V.ndim != 2 or V.shape[1] != 3:
+        raise MeshFileError(f"{path}: vertices are not 3D points (shape {V.shape})")
+    messages = list(cap.lines)
+    if ext == ".stl" and F.ndim == 2 and F.size and F.min() >= 0 and F.max() < len(V):
+        # STL stores every triangle with its own corners: weld exactly coincident points
+        V, _, J = igl.remove_duplicate_vertices(V, 0.0)
+        nV_before = len(J)
+        F = J[F]
+        messages.append(f"merged coincident STL vertices: {nV_before} -> {len(V)}")
+    return V, F, messages
+
+
+# --------------------------------------------------------------------------- writing
+def check_output_path(path):
+    """Check before any computation that ``path`` has a known extension and can be written.
+
+    Opens the file for appending (so an existing file is not truncated) and
+    removes it again if it did not exist.  Returns the extension (lower case).
+    """
+    path = Path(path)
+    ext = path.suffix.lower()
+    if ext not in OUTPUT_EXTENSIONS:
+        raise MeshFileError(f"{path}: unknown output extension {path.suffix!r} "
+                            f"(use {', '.join(OUTPUT_EXTENSIONS)})")
+    probe_writable(path)
+    return ext
+
+
+def probe_writable(path):
+    """Raise :class:`MeshFileError` unless ``path`` can be opened for writing.
+
+    Opens it for appending (an existing file is not truncated) and removes it
+    again if it did not exist, so nothing is left behind if a later step fails.
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise MeshFileError(f"{path}: is a directory")
+    existed = path.exists()
+    try:
+        with open(path, "ab"):
+            pass
+    except OSError as exc:
+        raise MeshFileError(f"{path}: cannot write: {exc.strerror or exc}") from None
+    if not existed:
+        path.unlink()
+
+
+def _columns(est):
+    """(n, 10) float64: k1, k2, H, K, d1, d2 (NaN directions if the method has none)."""
+    n = len(est.k1)
+    d1 = est.d1 if est.d1 is not None else np.full((n, 3), np.nan)
+    d2 = est.d2 if est.d2 is not None else np.full((n, 3), np.nan)
+    return np.column_stack([est.k1, est.k2, est.H, est.K, d1, d2])
+
+
+def _write_ply(path, V, F, est):
+    vprops = [("x", "<f8"), ("y", "<f8"), ("z", "<f8")]
+    fprops = [("n", "u1"), ("vertex_indices", "<i4", (3,))]
+    cols = [(c, "<f8") for c in CURVATURE_COLUMNS]
+    data = _columns(est)
+    per_vertex = est.location == "vertex"
+    vert = np.empty(len(V), dtype=vprops + (cols if per_vertex else []))
+    face = np.empty(len(F), dtype=fprops + ([] if per_vertex else cols))
+    vert["x"], vert["y"], vert["z"] = V.T
+    face["n"] = 3
+    face["vertex_indices"] = F
+    target = vert if per_vertex else face
+    for j, c in enumerate(CURVATURE_COLUMNS):
+        target[c] = data[:, j]
+    extra = "".join(f"property double {c}\n" for c in CURVATURE_COLUMNS)
+    header = ("ply\nformat binary_little_endian 1.0\n"
+              f"comment igl_hhj curvature, method {est.name}, per {est.location}\n"
+              f"element vertex {len(V)}\nproperty double x\nproperty double y\nproperty double z\n"
+              + (extra if per_vertex else "")
+              + f"element face {len(F)}\nproperty list uchar int vertex_indices\n"
+              + ("" if per_vertex else extra) + "end_header\n")
+    with open(path, "wb") as fh:
+        fh.write(header.encode("ascii"))
+        fh.write(vert.tobytes())
+        fh.write(face.tobytes())
+
+
+def write_curvature(path, V, F, est, *, method, S=None):
+    """Write curvatures per face or per vertex to ``.npz``, ``.csv`` or ``.ply``.
+
+    Parameters
+    ----------
+    path : str or os.PathLike, extension one of :data:`OUTPUT_EXTENSIONS`
+    V : (#V, 3) float64, F : (#F, 3) int64
+    est : igl_hhj.baselines.CurvatureEstimate
+        ``est.location`` ("vertex" or "face") says which element the rows are.
+    method : str
+        The method name stored in the file (``hhj``, ``igl``, ``heine``).
+    S : (#F, 3, 3) float64, optional
+        The HHJ shape operator, stored in the ``.npz`` only.
+
+    Files
+    -----
+    ``.npz``: arrays ``k1, k2, H, K (n,)``, ``d1, d2 (n, 3)``, ``V``, ``F``,
+    ``per`` and ``method`` (0-d strings), ``S`` when given.
+    ``.csv``: header ``index,k1,k2,H,K,d1x,d1y,d1z,d2x,d2y,d2z``, one row per
+    element, full float64 precision.
+    ``.ply``: binary little-endian; ``vertex`` x, y, z and ``face``
+    vertex_indices (uchar count, int indices); the columns of the csv as
+    ``double`` properties of the vertices or of the faces.
+    """
+    ext = Path(path).suffix.lower()
+    if ext == ".npz":
+        arrays = dict(k1=est.k1, k2=est.k2, H=est.H, K=est.K, V=V, F=F,
+                      per=np.array(est.location), method=np.array(method))
+        if est.d1 is not None:
+            arrays.update(d1=est.d1, d2=est.d2)
+        if S is not None:
+            arrays["S"] = S
+        np.savez(path, **arrays)
+    elif ext == ".csv":
+        data = _columns(est)
+        table = np.column_stack([np.arange(len(data)), data])
+        np.savetxt(path, table, delimiter=",", fmt=["%d"] + ["%.17g"] * data.shape[1],
+                   header=",".join(("index",) + CURVATURE_COLUMNS), comments="")
+    elif ext == ".ply":
+        _write_ply(path, V, F, est)
+    else:
+        raise MeshFileError(f"{path}: unknown output extension (use {', '.join(OUTPUT_EXTENSIONS)})")
