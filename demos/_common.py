@@ -1,0 +1,155 @@
+"""Shared plumbing of the demo scripts: command line, mesh loading, tables, rendering.
+
+Not part of the library: every demo imports it as ``_common`` (the demos folder
+is on ``sys.path`` when a script runs).
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from dataclasses import replace
+
+import numpy as np
+
+
+def parser(doc, *, levels=None, size=(1600, 800)):
+    """argparse parser with the demo docstring as description, ``--screenshot``,
+    ``--size`` and (if ``levels`` is given) ``--levels``."""
+    p = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--screenshot", metavar="PNG",
+                   help="render headless (EGL) to this PNG and exit instead of opening the viewer")
+    p.add_argument("--size", nargs=2, type=int, default=list(size), metavar=("W", "H"),
+                   help=f"screenshot size in pixels (default {size[0]} {size[1]})")
+    if levels is not None:
+        p.add_argument("--levels", type=int, default=levels,
+                       help=f"number of refinement levels (default {levels}; 2 is fast)")
+    return p
+
+
+def fail(message, code=2):
+    """One-line error on stderr and exit (no traceback for user errors)."""
+    prog = sys.argv[0].rsplit("/", 1)[-1] if sys.argv and sys.argv[0] else "demo"
+    print(f"{prog}: error: {message}", file=sys.stderr)
+    raise SystemExit(code)
+
+
+def check_levels(levels, minimum=2, maximum=7):
+    if not (minimum <= levels <= maximum):
+        fail(f"--levels must be between {minimum} and {maximum}, got {levels}")
+    return levels
+
+
+def read_mesh(path):
+    """(V, F) of any file ``igl.read_triangle_mesh`` reads, validated; exits with a
+    one-line message (code 2) if the file is missing, unreadable or not a valid mesh."""
+    import os
+
+    import igl
+
+    from igl_hhj.mesh import as_mesh
+    if not os.path.isfile(path):
+        fail(f"no such mesh file: {path!r}")
+    try:
+        V, F = igl.read_triangle_mesh(str(path))
+    except Exception as exc:  # libigl raises various errors on bad files
+        fail(f"cannot read mesh {path!r}: {str(exc).splitlines()[0] if str(exc) else type(exc).__name__}")
+    if V is None or F is None or len(V) == 0 or len(F) == 0:
+        fail(f"cannot read mesh {path!r}: no vertices or no triangles")
+    try:
+        mesh = as_mesh(V, F)
+    except (TypeError, ValueError) as exc:
+        fail(f"invalid mesh {path!r}: {str(exc).splitlines()[0]}")
+    return mesh.V, mesh.F
+
+
+# --------------------------------------------------------------------------- tables
+def eocs(values, hs):
+    """EOCs between successive levels (first entry NaN), as a list."""
+    from igl_hhj.convergence import eoc
+    if len(values) < 2:
+        return [np.nan] * len(values)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return [np.nan] + list(eoc(values, hs))
+
+
+def fmt(x):
+    if x is None or (isinstance(x, (float, np.floating)) and not np.isfinite(x)):
+        return "-"
+    if isinstance(x, (int, np.integer)):
+        return str(int(x))
+    if isinstance(x, str):
+        return x
+    return f"{x:.3g}" if 1e-3 <= abs(x) < 1e4 or x == 0 else f"{x:.2e}"
+
+
+def print_table(title, header, rows):
+    """Plain-text table on stdout (markdown-compatible)."""
+    cells = [[str(h) for h in header]] + [[fmt(c) for c in r] for r in rows]
+    w = [max(len(r[i]) for r in cells) for i in range(len(header))]
+    print(f"\n{title}")
+    line = lambda r: "| " + " | ".join(c.rjust(w[i]) for i, c in enumerate(r)) + " |"  # noqa: E731
+    print(line(cells[0]))
+    print("|" + "|".join("-" * (x + 2) for x in w) + "|")
+    for r in cells[1:]:
+        print(line(r))
+    sys.stdout.flush()
+
+
+# --------------------------------------------------------------------------- viewer
+def start_viewer(args):
+    """The viewer module, with polyscope started for headless rendering
+    (``--screenshot``) or for an interactive window."""
+    from igl_hhj import viewer
+    try:
+        ps = viewer.init("openGL3_egl" if args.screenshot else "auto")
+    except viewer.ViewerUnavailable as exc:
+        hint = "" if args.screenshot else " (no display? use --screenshot out.png for headless rendering)"
+        fail(f"{exc}{hint}".splitlines()[0], code=1)
+    # copies laid side by side must be seen from the same direction: no perspective
+    ps.set_view_projection_mode("orthographic")
+    return viewer
+
+
+def finish(viewer, args, registrations):
+    """Write the screenshot of ``registrations`` or open the interactive viewer."""
+    if args.screenshot:
+        try:
+            viewer.screenshot(args.screenshot, list(registrations), size=tuple(args.size))
+        except (ValueError, viewer.ViewerUnavailable) as exc:
+            fail(str(exc).splitlines()[0], code=1)
+        print(f"\nwrote {args.screenshot} ({args.size[0]} x {args.size[1]})")
+    else:
+        viewer.show()
+
+
+def register_field(viewer, V, F, label, values, vrange, *, name, offset=None, cmap="viridis"):
+    """One structure carrying one scalar field coloured on the given range ``vrange``.
+
+    ``viewer.register_scalars`` computes each structure's range from its own
+    values; pictures laid side by side need one common range, so the quantity
+    is re-added here with ``vrange`` (and the Registration record updated).
+    """
+    reg = viewer.register_scalars(V, F, {label: values}, name=name, offset=offset, cmap=cmap,
+                                  symmetric=False)
+    info = reg.quantities[(name, label)]
+    reg.structures[name].add_scalar_quantity(label, np.nan_to_num(info.values), defined_on=info.defined_on,
+                                             vminmax=tuple(vrange), cmap=cmap, enabled=True)
+    reg.quantities[(name, label)] = replace(info, vminmax=tuple(float(x) for x in vrange))
+    reg.ranges[label] = tuple(float(x) for x in vrange)
+    return reg
+
+
+def error_range(*arrays, robust=1.0):
+    """(0, hi): one colour range for non-negative error fields, ``hi`` the
+    ``100 - robust`` percentile of all values together."""
+    from igl_hhj import viewer
+    _, hi = viewer.color_range(*arrays, symmetric=False, robust=robust)
+    return 0.0, max(hi, 1e-300)
+
+
+def grid_offsets(V, n_cols, n_rows, gap=0.15):
+    """Translations laying out copies of a mesh in a grid (columns along x, rows along -y
+    in a plane facing the default camera)."""
+    ext = V.max(axis=0) - V.min(axis=0)
+    dx, dy = (1 + gap) * ext[0], (1 + gap) * ext[1]
+    return [[np.array([c * dx, -r * dy, 0.0]) for c in range(n_cols)] for r in range(n_rows)]
