@@ -146,7 +146,9 @@ def init(backend="auto"):
         ps.init(backend)
     except Exception as exc:
         _reset_after_failed_init(ps)
-        hint = f"; {_EGL_HINT}" if "egl" in backend.lower() else ""
+        hint = (f"; {_EGL_HINT}" if "egl" in backend.lower() else
+                "; without a display, pass screenshot='out.png' to render headless (EGL)" if backend == "auto"
+                else "")
         raise ViewerUnavailable(f"polyscope could not initialise backend {backend!r}: "
                                 f"{str(exc).replace('[polyscope] ', '')}{hint}") from None
     return ps
