@@ -175,7 +175,8 @@ def _check_ply(path, head, size):
             first = np.char.partition(face_lines, b" ")[:, 0]
             bad = np.flatnonzero(first != b"3")
             if bad.size:
-                raise MeshFileError(f"{path}: face {int(bad[0])} has {first[bad[0]].decode(errors='replace')} "
+                k = first[bad[0]].decode(errors="replace")
+                raise MeshFileError(f"{path}: face {int(bad[0])} has {k} "
                                     f"vertices: only triangle meshes are supported "
                                     f"(libigl's PLY reader aborts on mixed polygons)")
         start += n

@@ -1,0 +1,480 @@
+"""The ``igl-hhj`` command line: demo, curvature, info; output files; one-line user errors."""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import igl
+import numpy as np
+import pytest
+from conftest import MESH_DIR
+
+from igl_hhj import baselines, cli
+from igl_hhj.mesh import TriangleMesh
+
+COLUMNS = ["k1", "k2", "H", "K", "d1x", "d1y", "d1z", "d2x", "d2y", "d2z"]
+
+
+# --------------------------------------------------------------------------- helpers
+def unit_sphere(levels=3):
+    V, F = igl.icosahedron()
+    for _ in range(levels):
+        V, F = igl.upsample(V, F)
+        V = V / np.linalg.norm(V, axis=1, keepdims=True)
+    return V, F
+
+
+@pytest.fixture(scope="module")
+def sphere(tmp_path_factory):
+    """(path, V, F) of a unit sphere (642 vertices, outward normals) written as .off."""
+    V, F = unit_sphere()
+    path = tmp_path_factory.mktemp("sphere") / "sphere.off"
+    igl.write_triangle_mesh(str(path), V, F)
+    V, F = igl.read_triangle_mesh(str(path))          # what the CLI sees (ascii round trip)
+    return path, V, F
+
+
+def real_mesh(name):
+    path = MESH_DIR / name
+    if not path.is_file():
+        pytest.skip(f"{path} absent")
+    return path
+
+
+def write_off(path, V, F):
+    lines = ["OFF", f"{len(V)} {len(F)} 0"] + [" ".join(map(repr, map(float, v))) for v in V]
+    lines += ["3 " + " ".join(map(str, f)) for f in F]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def one_error_line(err):
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert len(lines) == 1, f"expected exactly one stderr line, got {lines!r}"
+    assert lines[0].startswith("igl-hhj: error: "), lines[0]
+    return lines[0]
+
+
+def read_ply_properties(path):
+    """Minimal binary-little-endian PLY reader: {element: structured array} (lists of 3 only)."""
+    raw = path.read_bytes()
+    end = raw.index(b"end_header\n") + len(b"end_header\n")
+    header = raw[:end].decode("ascii").splitlines()
+    assert header[:2] == ["ply", "format binary_little_endian 1.0"]
+    types = {"double": "<f8", "float": "<f4", "int": "<i4", "uchar": "u1"}
+    elements = []
+    for line in header:
+        w = line.split()
+        if w[0] == "element":
+            elements.append((w[1], int(w[2]), []))
+        elif w[0] == "property" and w[1] == "list":
+            elements[-1][2].extend([("n_" + w[4], types[w[2]]), (w[4], types[w[3]], (3,))])
+        elif w[0] == "property":
+            elements[-1][2].append((w[2], types[w[1]]))
+    out, offset = {}, end
+    for name, n, fields in elements:
+        dt = np.dtype(fields)
+        out[name] = np.frombuffer(raw, dtype=dt, count=n, offset=offset)
+        offset += n * dt.itemsize
+    assert offset == len(raw)
+    return out
+
+
+# --------------------------------------------------------------------------- demo
+def test_demo_table(capsys):
+    assert cli.main(["demo", "--levels", "2", "--no-screenshot"]) == 0
+    out = capsys.readouterr().out
+    assert "HHJ err H" in out and "EOC (last level)" in out and "wrote" not in out
+    rows = [line for line in out.splitlines() if line.strip()[:1].isdigit()]
+    assert len(rows) == 2
+
+
+def test_demo_is_headless_safe(tmp_path, monkeypatch, capsys):
+    """No EGL: one warning line naming the Debian packages, still exit 0 with the table."""
+    from igl_hhj import viewer
+
+    def unavailable(*args, **kwargs):
+        raise viewer.ViewerUnavailable("polyscope could not initialise backend 'openGL3_egl': no EGL")
+    monkeypatch.setattr(viewer, "register_comparison", unavailable)
+    monkeypatch.chdir(tmp_path)
+    assert cli.main(["demo", "--levels", "1"]) == 0
+    cap = capsys.readouterr()
+    assert "HHJ err H" in cap.out
+    lines = cap.err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("igl-hhj: warning:") and "libegl1" in lines[0]
+    assert not (tmp_path / "igl_hhj_demo.png").exists()
+
+
+def render_or_skip(argv, capsys):
+    """Run a screenshot command; skip when EGL is missing outside CI."""
+    code = cli.main(argv)
+    cap = capsys.readouterr()
+    if ("libegl1" in cap.err) and not os.environ.get("CI"):
+        pytest.skip("EGL libraries missing (not in CI)")
+    return code, cap
+
+
+def test_demo_writes_screenshot(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    code, cap = render_or_skip(["demo", "--levels", "2"], capsys)
+    assert code == 0
+    png = tmp_path / "igl_hhj_demo.png"
+    assert png.stat().st_size > 0 and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "igl_hhj_demo.png" in cap.out
+
+
+def test_demo_rejects_bad_options(tmp_path, capsys):
+    assert cli.main(["demo", "--levels", "0"]) == 2
+    assert "--levels" in one_error_line(capsys.readouterr().err)
+    assert cli.main(["demo", "--screenshot", str(tmp_path / "no" / "x.png")]) == 2
+    one_error_line(capsys.readouterr().err)
+
+
+# --------------------------------------------------------------------------- curvature
+@pytest.mark.parametrize("per", ["vertex", "face"])
+def test_curvature_outputs_agree_and_reread(sphere, tmp_path, capsys, per):
+    path, V, F = sphere
+    n = len(V) if per == "vertex" else len(F)
+    outs = {ext: tmp_path / f"k{ext}" for ext in (".npz", ".csv", ".ply")}
+    for out in outs.values():
+        assert cli.main(["curvature", str(path), "--per", per, "-o", str(out)]) == 0
+    assert "median" in capsys.readouterr().out
+
+    d = np.load(outs[".npz"])
+    assert set(d.files) == {"k1", "k2", "H", "K", "d1", "d2", "V", "F", "per", "method", "S"}
+    assert str(d["per"]) == per and str(d["method"]) == "hhj"
+    assert d["S"].shape == (len(F), 3, 3)
+    assert d["k1"].shape == (n,) and d["d1"].shape == (n, 3) and d["d2"].shape == (n, 3)
+    np.testing.assert_array_equal(d["V"], V)
+    np.testing.assert_array_equal(d["F"], F)
+    # the library's own values (the CLI is wiring, not a new estimator)
+    est = baselines.hhj_vertex(V, F) if per == "vertex" else baselines.hhj_face(V, F)
+    np.testing.assert_allclose(d["k1"], est.k1, rtol=1e-10)
+    np.testing.assert_allclose(d["K"], est.K, rtol=1e-10)
+    # unit sphere, outward normals: +1
+    for q in ("k1", "k2", "H", "K"):
+        assert abs(np.median(d[q]) - 1.0) < 0.01, q
+    assert np.all(np.abs(np.einsum("ij,ij->i", d["d1"], d["d2"])) < 1e-8)
+
+    csv = np.loadtxt(outs[".csv"], delimiter=",", skiprows=1)
+    assert outs[".csv"].read_text().splitlines()[0] == ",".join(["index"] + COLUMNS)
+    assert csv.shape == (n, 11)
+    np.testing.assert_array_equal(csv[:, 0], np.arange(n))
+    np.testing.assert_array_equal(csv[:, 1:], np.column_stack([d["k1"], d["k2"], d["H"], d["K"],
+                                                               d["d1"], d["d2"]]))
+
+    V2, F2 = igl.read_triangle_mesh(str(outs[".ply"]))
+    np.testing.assert_array_equal(V2, V)
+    np.testing.assert_array_equal(F2, F)
+    ply = read_ply_properties(outs[".ply"])
+    assert np.all(ply["face"]["n_vertex_indices"] == 3)
+    np.testing.assert_array_equal(ply["face"]["vertex_indices"], F)
+    table = ply[per]
+    for j, c in enumerate(COLUMNS):
+        np.testing.assert_array_equal(table[c], csv[:, 1 + j])
+    other = "face" if per == "vertex" else "vertex"
+    assert "k1" not in ply[other].dtype.names
+
+
+@pytest.mark.parametrize("method, fn", [("igl", baselines.libigl_quadric), ("heine", baselines.heine)])
+def test_curvature_methods_are_the_baselines(sphere, tmp_path, method, fn):
+    path, V, F = sphere
+    out = tmp_path / "k.npz"
+    assert cli.main(["curvature", str(path), "--method", method, "-o", str(out), "-q"]) == 0
+    d = np.load(out)
+    est = fn(V, F)
+    assert "S" not in d.files and str(d["method"]) == method and str(d["per"]) == "vertex"
+    np.testing.assert_allclose(d["k1"], est.k1, rtol=1e-10)
+    np.testing.assert_allclose(d["H"], est.H, rtol=1e-10)
+    assert np.median(d["H"]) > 0                       # outward sphere: positive
+
+
+def test_curvature_sign_follows_orientation(tmp_path):
+    V, F = unit_sphere(2)
+    path = write_off(tmp_path / "inward.off", V, F[:, ::-1])
+    out = tmp_path / "k.npz"
+    assert cli.main(["curvature", str(path), "-o", str(out)]) == 0
+    assert abs(np.median(np.load(out)["H"]) + 1.0) < 0.05
+
+
+def test_curvature_per_face_needs_hhj(sphere, capsys):
+    path, _, _ = sphere
+    for method in ("igl", "heine"):
+        assert cli.main(["curvature", str(path), "--method", method, "--per", "face"]) == 2
+        assert "per-vertex" in one_error_line(capsys.readouterr().err)
+
+
+def test_progress_lines_only_for_large_meshes(sphere, tmp_path, monkeypatch, capsys):
+    path, _, _ = sphere
+    out = str(tmp_path / "k.csv")
+    assert cli.main(["curvature", str(path), "-o", out]) == 0
+    assert capsys.readouterr().err == ""
+    monkeypatch.setattr(cli, "LARGE_MESH_FACES", 100)
+    assert cli.main(["curvature", str(path), "-o", out]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert [ln[:5] for ln in err] == ["[1/3]", "[2/3]", "[3/3]"]
+    assert "HHJ solve" in err[1] and err[1].endswith(" s")
+    assert cli.main(["curvature", str(path), "-o", out, "--quiet"]) == 0
+    assert capsys.readouterr().err == ""
+
+
+def test_output_errors_come_before_computing(sphere, tmp_path, monkeypatch, capsys):
+    path, _, _ = sphere
+
+    def must_not_run(*args, **kwargs):
+        raise AssertionError("computed before checking the output")
+    monkeypatch.setattr(baselines, "estimate", must_not_run)
+    monkeypatch.setattr(cli, "_read", must_not_run)
+    for out in ["/nonexistent/dir/x.npz", str(tmp_path / "x.txt"), str(tmp_path)]:
+        assert cli.main(["curvature", str(path), "-o", out]) == 2
+        one_error_line(capsys.readouterr().err)
+    assert cli.main(["curvature", str(path), "--screenshot", "/nonexistent/dir/x.png"]) == 2
+    one_error_line(capsys.readouterr().err)
+    assert list(tmp_path.iterdir()) == []                 # the write probe leaves nothing behind
+
+
+def test_failed_run_keeps_existing_output(tmp_path, capsys):
+    bad = write_off(tmp_path / "nm.off", *NONMANIFOLD)
+    out = tmp_path / "k.csv"
+    out.write_text("previous results\n")
+    assert cli.main(["curvature", str(bad), "-o", str(out)]) == 2
+    one_error_line(capsys.readouterr().err)
+    assert out.read_text() == "previous results\n"
+
+
+def test_curvature_real_mesh_with_boundary(tmp_path, capsys):
+    path = real_mesh("camelhead.off")
+    out = tmp_path / "camel.csv"
+    assert cli.main(["curvature", str(path), "-o", str(out)]) == 0
+    assert "56 boundary edges" in capsys.readouterr().out
+    V, F = igl.read_triangle_mesh(str(path))
+    csv = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert csv.shape == (len(V), 11) and np.isfinite(csv).all()
+    np.testing.assert_allclose(csv[:, 1], baselines.hhj_vertex(V, F).k1, rtol=1e-12, atol=1e-12)
+
+
+def test_curvature_real_mesh_per_face_ply(tmp_path):
+    path = real_mesh("fandisk.off")
+    out = tmp_path / "fandisk.ply"
+    assert cli.main(["curvature", str(path), "--per", "face", "-o", str(out)]) == 0
+    V, F = igl.read_triangle_mesh(str(path))
+    V2, F2 = igl.read_triangle_mesh(str(out))
+    np.testing.assert_array_equal(F2, F)
+    np.testing.assert_allclose(V2, V, rtol=0, atol=0)
+    ply = read_ply_properties(out)
+    assert len(ply["face"]) == len(F) and np.isfinite(ply["face"]["H"]).all()
+
+
+def test_curvature_screenshot(sphere, tmp_path, capsys):
+    path, _, _ = sphere
+    png = tmp_path / "sphere.png"
+    code, cap = render_or_skip(["curvature", str(path), "--screenshot", str(png)], capsys)
+    assert code == 0 and png.stat().st_size > 0 and str(png) in cap.out
+
+
+def test_curvature_view_registers_the_estimate(sphere, monkeypatch, capsys):
+    from igl_hhj import viewer
+    calls = []
+    monkeypatch.setattr(viewer, "register_curvature", lambda V, F, **kw: calls.append((len(V), len(F), kw)))
+    monkeypatch.setattr(viewer, "show", lambda: calls.append("show"))
+    path, V, F = sphere
+    assert cli.main(["curvature", str(path), "--per", "face", "--view"]) == 0
+    (nv, nf, kw), shown = calls
+    assert (nv, nf) == (len(V), len(F)) and shown == "show"
+    assert kw["name"] == "sphere" and kw["estimate"].location == "face" and kw["robust"] == 1.0
+
+
+def test_curvature_screenshot_without_egl_is_a_user_error(sphere, tmp_path, monkeypatch, capsys):
+    from igl_hhj import viewer
+
+    def unavailable(*args, **kwargs):
+        raise viewer.ViewerUnavailable("no EGL\nsecond line")
+    monkeypatch.setattr(viewer, "register_curvature", unavailable)
+    path, _, _ = sphere
+    assert cli.main(["curvature", str(path), "--screenshot", str(tmp_path / "x.png")]) == 2
+    assert "libegl1" in one_error_line(capsys.readouterr().err)
+
+
+# --------------------------------------------------------------------------- info
+def info(path, capsys):
+    code = cli.main(["info", str(path)])
+    cap = capsys.readouterr()
+    rows = {}
+    for line in cap.out.splitlines()[1:]:
+        key, _, value = line.strip().partition("  ")
+        rows[key.strip()] = value.strip()
+    return code, rows, cap
+
+
+def test_info_sphere(sphere, capsys):
+    path, V, F = sphere
+    code, rows, cap = info(path, capsys)
+    assert code == 0 and cap.err == ""
+    assert rows["vertices"] == f"{len(V)} (0 unreferenced)" and rows["faces"] == str(len(F))
+    assert rows["edges"] == f"{len(V) + len(F) - 2} (0 on the boundary)"    # Euler: V - E + F = 2
+    assert rows["components"] == "1" and rows["boundary loops"] == "0"
+    assert rows["Euler char."] == "2" and rows["genus"] == "0"
+    assert rows["edge-manifold"] == "yes" and rows["vertex-manifold"] == "yes"
+    assert rows["orientation"] == "consistent, orientable"
+    assert rows["degenerate faces"] == "0 zero-area, 0 with a repeated vertex"
+    assert rows["verdict"] == "accepted by igl_hhj"
+
+
+def test_info_torus_and_two_components(tmp_path, capsys):
+    from igl_hhj.surfaces import torus_coarse
+    V, F = torus_coarse(n_phi=12, n_t=6, amount=0.0)
+    code, rows, _ = info(write_off(tmp_path / "torus.off", V, F), capsys)
+    assert code == 0 and rows["genus"] == "1" and rows["Euler char."] == "0"
+    # a hole (one face removed) adds a boundary loop, keeps the genus: χ = 2 - 2g - b
+    code, rows, _ = info(write_off(tmp_path / "holed.off", V, F[1:]), capsys)
+    assert code == 0 and rows["boundary loops"] == "1 (edges per loop: 3)"
+    assert rows["Euler char."] == "-1" and rows["genus"] == "1"
+    V, F = unit_sphere(1)
+    two = write_off(tmp_path / "two.off", np.vstack([V, V + 3]), np.vstack([F, F + len(V)]))
+    code, rows, _ = info(two, capsys)
+    assert code == 0 and rows["components"] == "2" and rows["genus"] == "0 (per component: 0, 0)"
+
+
+def test_info_real_meshes(capsys):
+    path = real_mesh("camelhead.off")
+    code, rows, _ = info(path, capsys)
+    mesh = TriangleMesh(*igl.read_triangle_mesh(str(path)))
+    loops = sorted((len(lp) for lp in mesh.boundary_loops), reverse=True)    # libigl's loops
+    assert code == 0 and len(loops) >= 1
+    assert rows["boundary loops"] == f"{len(loops)} (edges per loop: {', '.join(map(str, loops))})"
+    assert rows["genus"] == "0"
+    path = real_mesh("fertility.off")
+    code, rows, _ = info(path, capsys)
+    assert code == 0 and rows["genus"] == "4" and rows["boundary loops"] == "0"
+
+
+NONMANIFOLD = (np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1.0]]),
+               np.array([[0, 1, 2], [1, 0, 3], [0, 1, 4]]))                # three faces on edge 0-1
+DEGENERATE = (np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [2, 0, 0.0]]),
+              np.array([[0, 1, 2], [0, 3, 1]]))                            # face 1 is collinear
+FLIPPED = (np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.0]]),
+           np.array([[0, 1, 2], [1, 2, 3]]))                               # both traverse 1 -> 2
+
+
+def moebius(n=8, w=0.3):
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    V = np.vstack([np.c_[(1 + s * np.cos(t / 2)) * np.cos(t), (1 + s * np.cos(t / 2)) * np.sin(t),
+                         s * np.sin(t / 2)] for s in (-w, w)])
+    i = np.arange(n)
+    j = (i + 1) % n
+    a1 = np.where(j == 0, n, j)                       # the seam swaps the two rims
+    b1 = np.where(j == 0, 0, j + n)
+    return V, np.vstack([np.c_[i, a1, i + n], np.c_[i + n, a1, b1]])
+
+
+@pytest.mark.parametrize("mesh, row, value", [
+    (NONMANIFOLD, "edge-manifold", "no (1 edges with more than two faces)"),
+    (DEGENERATE, "degenerate faces", "1 zero-area, 0 with a repeated vertex"),
+    (FLIPPED, "orientation", "inconsistent (1 edges traversed twice in the same direction), orientable"),
+    (moebius(), "genus", "not defined: non-orientable"),
+], ids=["nonmanifold", "degenerate", "flipped", "moebius"])
+def test_info_rejected_meshes(tmp_path, capsys, mesh, row, value):
+    path = write_off(tmp_path / "m.off", *mesh)
+    with pytest.raises(ValueError) as exc:
+        TriangleMesh(*igl.read_triangle_mesh(str(path)))
+    code, rows, cap = info(path, capsys)
+    assert code == 1 and cap.err == ""
+    assert rows[row] == value
+    assert rows["verdict"] == f"rejected: {exc.value}"
+
+
+def test_info_mesh_with_bad_indices_is_rejected_not_crashed(tmp_path, capsys):
+    path = tmp_path / "oor.obj"
+    path.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n")
+    code, rows, _ = info(path, capsys)
+    assert code == 1 and rows["topology"].startswith("not analysed")
+    assert rows["verdict"].startswith("rejected: F has out-of-range vertex indices")
+
+
+def test_info_stl_vertices_are_welded(tmp_path, capsys):
+    V, F = unit_sphere(1)
+    path = tmp_path / "s.stl"
+    igl.write_triangle_mesh(str(path), V, F)
+    code, rows, cap = info(path, capsys)
+    assert code == 0 and rows["vertices"] == f"{len(V)} (0 unreferenced)" and rows["genus"] == "0"
+    assert "merged coincident STL vertices" in cap.err
+
+
+def test_info_subprocess_exit_codes(sphere, tmp_path):
+    path, _, _ = sphere
+    run = subprocess.run([sys.executable, "-m", "igl_hhj.cli", "info", str(path)],
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0 and "accepted by igl_hhj" in run.stdout and run.stderr == ""
+    bad = write_off(tmp_path / "nm.off", *NONMANIFOLD)
+    run = subprocess.run([sys.executable, "-m", "igl_hhj.cli", "info", str(bad)],
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 1 and "rejected: mesh has non-manifold edges" in run.stdout
+
+
+# --------------------------------------------------------------------------- bad input
+BAD_FILES = {
+    "missing.off": None,
+    "empty.off": b"",
+    "garbage.off": b"OFF\nfoo bar\n",
+    "random.off": bytes(range(256)) * 4,
+    "garbage.obj": b"hello world\n",
+    "points.xyz": b"1 2 3\n",
+    "no_faces.off": b"OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n",
+    "huge_counts.off": b"OFF\n100000000 1 0\n0 0 0\n",                         # libigl: 5 GB
+    "truncated.off": b"OFF\n3 1 0\n0 0 0\n1 0 0\n",
+    # libigl: endless loop
+    "huge_counts.ply": (b"ply\nformat binary_little_endian 1.0\nelement vertex 100000000000\n"
+                        b"property float x\nproperty float y\nproperty float z\nend_header\n"),
+    "short_faces.ply": (b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                        b"property float z\nelement face 2\nproperty list uchar int vertex_indices\n"
+                        b"end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"),           # libigl: double free
+    "mixed.ply": (b"ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                  b"property float z\nelement face 2\nproperty list uchar int vertex_indices\n"
+                  b"end_header\n0 0 0\n1 0 0\n0 1 0\n1 1 1\n3 0 1 2\n4 0 1 2 3\n"),  # libigl: abort
+    "garbage.stl": bytes(range(256)) + b"solid",
+    "garbage.mesh": b"garbage",
+}
+
+
+@pytest.mark.parametrize("command", ["curvature", "info"])
+@pytest.mark.parametrize("name", sorted(BAD_FILES))
+def test_bad_files_give_one_line(tmp_path, capfd, command, name):
+    """capfd: libigl's own C/C++ messages on file descriptors 1/2 must not leak either."""
+    path = tmp_path / name
+    if BAD_FILES[name] is not None:
+        path.write_bytes(BAD_FILES[name])
+    assert cli.main([command, str(path)]) == 2
+    cap = capfd.readouterr()
+    assert str(path) in one_error_line(cap.err)
+    assert cap.out == ""
+
+
+def test_directory_and_unreadable_file(tmp_path, capsys):
+    folder = tmp_path / "folder.off"
+    folder.mkdir()
+    assert cli.main(["info", str(folder)]) == 2
+    assert "directory" in one_error_line(capsys.readouterr().err)
+    if os.geteuid() != 0:                                  # root reads everything
+        locked = write_off(tmp_path / "locked.off", *FLIPPED)
+        locked.chmod(0)
+        assert cli.main(["curvature", str(locked)]) == 2
+        assert "cannot read" in one_error_line(capsys.readouterr().err)
+
+
+@pytest.mark.parametrize("mesh, match", [(NONMANIFOLD, "non-manifold"), (DEGENERATE, "degenerate"),
+                                         (FLIPPED, "not consistently oriented")])
+def test_curvature_bad_mesh_is_one_line(tmp_path, capsys, mesh, match):
+    path = write_off(tmp_path / "bad.off", *mesh)
+    assert cli.main(["curvature", str(path)]) == 2
+    line = one_error_line(capsys.readouterr().err)
+    assert match in line and "igl-hhj info" in line
+
+
+def test_usage_errors_are_one_line(capsys):
+    assert cli.main([]) == 2
+    one_error_line(capsys.readouterr().err)
+    assert cli.main(["curvature", "x.off", "--per", "edge"]) == 2
+    assert "invalid choice" in one_error_line(capsys.readouterr().err)
+    assert cli.main(["curvature", "--help"]) == 0
+    assert "--method" in capsys.readouterr().out
