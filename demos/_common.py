@@ -40,25 +40,17 @@ def check_levels(levels, minimum=2, maximum=7):
 
 
 def read_mesh(path):
-    """(V, F) of any file ``igl.read_triangle_mesh`` reads, validated; exits with a
-    one-line message (code 2) if the file is missing, unreadable or not a valid mesh."""
-    import os
-
-    import igl
-
+    """(V, F) of any file ``igl.read_triangle_mesh`` reads, through the guarded
+    reader :func:`igl_hhj.mesh_io.read_mesh`, validated; exits with a one-line
+    message (code 2) if the file is missing, unreadable or not a valid mesh."""
     from igl_hhj.mesh import as_mesh
-    if not os.path.isfile(path):
-        fail(f"no such mesh file: {path!r}")
+    from igl_hhj.mesh_io import MeshFileError
+    from igl_hhj.mesh_io import read_mesh as guarded_read
     try:
-        V, F = igl.read_triangle_mesh(str(path))
-    except Exception as exc:  # libigl raises various errors on bad files
-        fail(f"cannot read mesh {path!r}: {str(exc).splitlines()[0] if str(exc) else type(exc).__name__}")
-    if V is None or F is None or len(V) == 0 or len(F) == 0:
-        fail(f"cannot read mesh {path!r}: no vertices or no triangles")
-    try:
+        V, F, _ = guarded_read(path)
         mesh = as_mesh(V, F)
-    except (TypeError, ValueError) as exc:
-        fail(f"invalid mesh {path!r}: {str(exc).splitlines()[0]}")
+    except (MeshFileError, TypeError, ValueError) as exc:
+        fail(f"{path}: {str(exc).splitlines()[0]}" if str(path) not in str(exc) else str(exc).splitlines()[0])
     return mesh.V, mesh.F
 
 
@@ -114,12 +106,47 @@ def finish(viewer, args, registrations):
     """Write the screenshot of ``registrations`` or open the interactive viewer."""
     if args.screenshot:
         try:
-            viewer.screenshot(args.screenshot, list(registrations), size=tuple(args.size))
+            framed_screenshot(viewer, args.screenshot, list(registrations), tuple(args.size))
         except (ValueError, viewer.ViewerUnavailable) as exc:
             fail(str(exc).splitlines()[0], code=1)
         print(f"\nwrote {args.screenshot} ({args.size[0]} x {args.size[1]})")
     else:
         viewer.show()
+
+
+def framed_screenshot(viewer, path, registrations, size, supersample=2, margin=0.04):
+    """``viewer.screenshot`` with the picture filling the frame.
+
+    polyscope's home view fits the bounding-box diagonal into the window
+    height, which leaves wide layouts (copies side by side) small in the
+    middle.  This renders at ``supersample`` × ``size``, crops to the drawn
+    pixels plus ``margin`` at the aspect ratio of ``size``, and resamples to
+    ``size`` (Pillow, which matplotlib depends on; without it the plain
+    screenshot is kept).
+    """
+    W, H = (int(x) for x in size)
+    try:
+        from PIL import Image
+    except ImportError:  # pragma: no cover - Pillow comes with matplotlib
+        return viewer.screenshot(path, registrations, size=(W, H))
+    viewer.screenshot(path, registrations, size=(supersample * W, supersample * H))
+    with Image.open(path) as im:
+        img = im.convert("RGB")
+    a = np.asarray(img).astype(np.int16)
+    drawn = np.abs(a - a[0, 0]).sum(axis=2) > 6                    # differs from the background colour
+    if not drawn.any():
+        img.resize((W, H), Image.LANCZOS).save(path)
+        return path
+    rows, cols = np.flatnonzero(drawn.any(axis=1)), np.flatnonzero(drawn.any(axis=0))
+    y0, y1, x0, x1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
+    cw, ch = (x1 - x0) * (1 + 2 * margin), (y1 - y0) * (1 + 2 * margin)
+    cw, ch = max(cw, ch * W / H), max(ch, cw * H / W)               # aspect of the requested size
+    cx, cy = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
+    box = tuple(int(round(v)) for v in (cx - cw / 2, cy - ch / 2, cx + cw / 2, cy + ch / 2))
+    canvas = Image.new("RGB", (box[2] - box[0], box[3] - box[1]), tuple(int(c) for c in a[0, 0]))
+    canvas.paste(img, (-box[0], -box[1]))                           # crop, padding with background
+    canvas.resize((W, H), Image.LANCZOS).save(path)
+    return path
 
 
 def register_field(viewer, V, F, label, values, vrange, *, name, offset=None, cmap="viridis"):
