@@ -30,6 +30,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .mesh_io import CapturedOutput
+
 EGL_HINT = ("headless rendering needs EGL; on Debian/Ubuntu: "
             "apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri")
 LARGE_MESH_FACES = 100_000
@@ -111,6 +113,12 @@ def _viewer():
     return viewer
 
 
+def _quietly(fn, *args, **kwargs):
+    """Call ``fn`` with file descriptors 1/2 captured (polyscope's EGL start-up chatter)."""
+    with CapturedOutput():
+        return fn(*args, **kwargs)
+
+
 # --------------------------------------------------------------------------- demo
 def _demo(args):
     import igl
@@ -154,7 +162,7 @@ def _demo(args):
     if shot is not None:
         viewer = _viewer()
         try:
-            viewer.register_comparison(V, F, enabled="H", robust=2.0, screenshot=str(shot))
+            _quietly(viewer.register_comparison, V, F, enabled="H", robust=2.0, screenshot=str(shot))
         except viewer.ViewerUnavailable as exc:
             print(f"igl-hhj: warning: no screenshot ({_first_line(exc)}); {EGL_HINT}", file=sys.stderr)
         else:
@@ -227,8 +235,8 @@ def _curvature(args):
                 viewer.register_curvature(mesh.V, mesh.F, estimate=est, name=name, robust=robust)
                 viewer.show()
             if args.screenshot is not None:
-                stages.run("screenshot", viewer.register_curvature, mesh.V, mesh.F, estimate=est,
-                           name=name, robust=robust, screenshot=str(args.screenshot))
+                stages.run("screenshot", _quietly, viewer.register_curvature, mesh.V, mesh.F,
+                           estimate=est, name=name, robust=robust, screenshot=str(args.screenshot))
                 print(f"  wrote {args.screenshot}")
         except viewer.ViewerUnavailable as exc:
             raise UserError(f"viewer unavailable: {_first_line(exc)}; {EGL_HINT}") from None

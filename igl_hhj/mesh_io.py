@@ -33,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["MeshFileError", "MESH_EXTENSIONS", "OUTPUT_EXTENSIONS", "read_mesh",
+__all__ = ["MeshFileError", "CapturedOutput", "MESH_EXTENSIONS", "OUTPUT_EXTENSIONS", "read_mesh",
            "check_output_path", "probe_writable", "write_curvature", "CURVATURE_COLUMNS"]
 
 MESH_EXTENSIONS = (".obj", ".off", ".ply", ".stl", ".wrl", ".mesh", ".msh")
@@ -191,8 +191,13 @@ def _flush_c_stdio():
         pass
 
 
-class _CapturedOutput:
-    """Redirect file descriptors 1 and 2 (libigl's C/C++ messages) into a temporary file."""
+class CapturedOutput:
+    """Context manager: redirect file descriptors 1 and 2 into a temporary file.
+
+    Silences C/C++ libraries (libigl's readers, polyscope's EGL start-up)
+    that print to the process's stdout/stderr; afterwards ``lines`` holds
+    their first 20 non-empty lines, non-ASCII characters replaced by '?'.
+    """
 
     def __enter__(self):
         import sys
@@ -257,7 +262,7 @@ def read_mesh(path):
     elif ext == ".ply":
         _check_ply(path, head, size)
     import igl
-    with _CapturedOutput() as cap:
+    with CapturedOutput() as cap:
         try:
             V, F = igl.read_triangle_mesh(str(path))
             exc = None
