@@ -216,8 +216,10 @@ def _curvature(args):
         print(f"  {name:>3}: 1% {q[0]: .4g}   median {q[1]: .4g}   99% {q[2]: .4g}")
     n_nan = int(np.isnan(est.k1).sum())
     if n_nan:
-        print(f"  {n_nan} {per}s have no value (NaN): "
-              + ("unreferenced vertices" if args.method == "hhj" else "see the method's 'bad' rows"))
+        why = {"hhj": "unreferenced vertices", "heine": "unreferenced vertices",
+               "igl": "unreferenced vertices and those libigl flags as bad (< 6 neighbours)"}
+        print(f"  {n_nan} {'vertice' if per == 'vertex' else 'face'}s have no value (NaN): "
+              f"{why[args.method]}")
 
     if args.out is not None:
         S = None

@@ -101,8 +101,9 @@ class MeshReport:
                                         f"inconsistent ({self.n_misoriented_edges} edges traversed "
                                         f"twice in the same direction)")
                 + {True: ", orientable", False: ", non-orientable", None: ""}[self.orientable],
-                f"degenerate faces  {self.n_zero_area_faces} zero-area, "
-                f"{self.n_repeated_vertex_faces} with a repeated vertex",
+                "degenerate faces  " + (f"{self.n_zero_area_faces} zero-area, " if self.n_zero_area_faces
+                                        is not None else "zero-area not checked (non-finite coordinates), ")
+                + f"{self.n_repeated_vertex_faces} with a repeated vertex",
                 f"duplicate faces   {self.n_duplicate_faces}",
             ]
         if self.bbox is not None:

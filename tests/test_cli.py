@@ -198,6 +198,18 @@ def test_curvature_sign_follows_orientation(tmp_path):
     assert abs(np.median(np.load(out)["H"]) + 1.0) < 0.05
 
 
+def test_unreferenced_vertex_is_nan_in_every_format(tmp_path, capsys):
+    V, F = unit_sphere(2)
+    path = write_off(tmp_path / "extra.off", np.vstack([V, [[5.0, 5.0, 5.0]]]), F)
+    for ext in (".csv", ".ply"):
+        assert cli.main(["curvature", str(path), "-o", str(tmp_path / f"k{ext}")]) == 0
+    assert "1 vertices have no value (NaN): unreferenced" in capsys.readouterr().out
+    csv = np.loadtxt(tmp_path / "k.csv", delimiter=",", skiprows=1)
+    vert = read_ply_properties(tmp_path / "k.ply")["vertex"]
+    assert np.isnan(csv[-1, 1:]).all() and np.isfinite(csv[:-1]).all()
+    assert np.isnan(vert["H"][-1]) and np.isfinite(vert["H"][:-1]).all()
+
+
 def test_curvature_per_face_needs_hhj(sphere, capsys):
     path, _, _ = sphere
     for method in ("igl", "heine"):
