@@ -184,6 +184,8 @@ def _curvature(args):
     if args.method != "hhj" and per == "face":
         raise UserError(f"--method {args.method} computes per-vertex curvature only; "
                         f"use --per vertex (or --method hhj for per-face values)")
+    if not 0 <= args.robust < 50:
+        raise UserError(f"--robust must be a percentile in [0, 50), got {args.robust}")
     if args.out is not None:
         _check_writable(args.out)
     if args.screenshot is not None:
@@ -232,16 +234,20 @@ def _curvature(args):
         viewer = _viewer()
         name = Path(args.mesh).stem
         robust = args.robust if args.robust > 0 else None
-        try:
-            if args.view:        # first: the interactive window cannot open after an EGL render
+        if args.view:            # first: the interactive window cannot open after an EGL render
+            try:
                 viewer.register_curvature(mesh.V, mesh.F, estimate=est, name=name, robust=robust)
                 viewer.show()
-            if args.screenshot is not None:
+            except viewer.ViewerUnavailable as exc:
+                raise UserError(f"cannot open the viewer window: {_first_line(exc)} "
+                                f"(without a display use --screenshot PNG)") from None
+        if args.screenshot is not None:
+            try:
                 stages.run("screenshot", _quietly, viewer.register_curvature, mesh.V, mesh.F,
                            estimate=est, name=name, robust=robust, screenshot=str(args.screenshot))
-                print(f"  wrote {args.screenshot}")
-        except viewer.ViewerUnavailable as exc:
-            raise UserError(f"viewer unavailable: {_first_line(exc)}; {EGL_HINT}") from None
+            except viewer.ViewerUnavailable as exc:
+                raise UserError(f"no screenshot: {_first_line(exc)}; {EGL_HINT}") from None
+            print(f"  wrote {args.screenshot}")
     return 0
 
 

@@ -297,7 +297,7 @@ def test_curvature_view_registers_the_estimate(sphere, monkeypatch, capsys):
     assert kw["name"] == "sphere" and kw["estimate"].location == "face" and kw["robust"] == 1.0
 
 
-def test_curvature_screenshot_without_egl_is_a_user_error(sphere, tmp_path, monkeypatch, capsys):
+def test_viewer_unavailable_is_a_user_error(sphere, tmp_path, monkeypatch, capsys):
     from igl_hhj import viewer
 
     def unavailable(*args, **kwargs):
@@ -306,6 +306,8 @@ def test_curvature_screenshot_without_egl_is_a_user_error(sphere, tmp_path, monk
     path, _, _ = sphere
     assert cli.main(["curvature", str(path), "--screenshot", str(tmp_path / "x.png")]) == 2
     assert "libegl1" in one_error_line(capsys.readouterr().err)
+    assert cli.main(["curvature", str(path), "--view"]) == 2
+    assert "--screenshot" in one_error_line(capsys.readouterr().err)
 
 
 # --------------------------------------------------------------------------- info
@@ -488,5 +490,7 @@ def test_usage_errors_are_one_line(capsys):
     one_error_line(capsys.readouterr().err)
     assert cli.main(["curvature", "x.off", "--per", "edge"]) == 2
     assert "invalid choice" in one_error_line(capsys.readouterr().err)
+    assert cli.main(["curvature", "x.off", "--robust", "50"]) == 2
+    assert "--robust" in one_error_line(capsys.readouterr().err)
     assert cli.main(["curvature", "--help"]) == 0
     assert "--method" in capsys.readouterr().out
