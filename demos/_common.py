@@ -150,19 +150,27 @@ def framed_screenshot(viewer, path, registrations, size, supersample=2, margin=0
 
 
 def register_field(viewer, V, F, label, values, vrange, *, name, offset=None, cmap="viridis"):
-    """One structure carrying one scalar field coloured on the given range ``vrange``.
-
-    ``viewer.register_scalars`` computes each structure's range from its own
-    values; pictures laid side by side need one common range, so the quantity
-    is re-added here with ``vrange`` (and the Registration record updated).
-    """
+    """One structure carrying one scalar field coloured on the given range ``vrange``."""
     reg = viewer.register_scalars(V, F, {label: values}, name=name, offset=offset, cmap=cmap,
                                   symmetric=False)
-    info = reg.quantities[(name, label)]
-    reg.structures[name].add_scalar_quantity(label, np.nan_to_num(info.values), defined_on=info.defined_on,
-                                             vminmax=tuple(vrange), cmap=cmap, enabled=True)
-    reg.quantities[(name, label)] = replace(info, vminmax=tuple(float(x) for x in vrange))
-    reg.ranges[label] = tuple(float(x) for x in vrange)
+    return set_range(reg, vrange)
+
+
+def set_range(reg, vrange):
+    """Put every scalar quantity of ``reg`` on the colour range ``vrange`` (kept enabled state).
+
+    The viewer's ``register_*`` functions compute each call's range from its
+    own values; pictures laid side by side need one common range, so the
+    quantities are re-added here with ``vrange`` and the Registration record
+    is updated to match.
+    """
+    vrange = tuple(float(x) for x in vrange)
+    items = sorted(((k, q) for k, q in reg.quantities.items() if q.kind == "scalar"), key=lambda kq: kq[1].enabled)
+    for (sname, qname), q in items:                         # the enabled one last, as the viewer does
+        reg.structures[sname].add_scalar_quantity(qname, np.nan_to_num(q.values), defined_on=q.defined_on,
+                                                  vminmax=vrange, cmap=q.cmap, enabled=q.enabled)
+        reg.quantities[(sname, qname)] = replace(q, vminmax=vrange)
+    reg.ranges = {k: vrange for k in reg.ranges}
     return reg
 
 
