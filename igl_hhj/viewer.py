@@ -55,7 +55,7 @@ LABELS = {"k1": "kappa1", "k2": "kappa2", "H": "mean H", "K": "Gauss K"}
 _TAG = {"hhj": "HHJ", "igl": "libigl", "heine": "Heine"}
 _EGL_HINT = ("headless rendering needs EGL: on Debian/Ubuntu `apt-get install libegl1 libegl-mesa0 "
              "libgl1-mesa-dri`")
-_REGISTERED = set()  # names of the structures this module registered (they may since be removed)
+_REGISTERED = {}  # name -> (2, 3) bounds of the structures this module registered (they may since be removed)
 
 
 class ViewerUnavailable(RuntimeError):
@@ -278,7 +278,7 @@ def _surface(ps, reg, name, V, F):
     box = np.stack([V.min(axis=0), V.max(axis=0)])
     reg.bounds = box if reg.bounds is None else np.stack([np.minimum(reg.bounds[0], box[0]),
                                                           np.maximum(reg.bounds[1], box[1])])
-    _REGISTERED.add(name)
+    _REGISTERED[name] = box
     return s
 
 
@@ -739,11 +739,13 @@ def _render(reg, path, size):
                                 "(which starts the EGL backend) or call viewer.init('openGL3_egl') first")
     ps.set_window_size(w, h)
     ps.set_ground_plane_mode("none")
+    projection = ps.get_view_projection_mode()
     # look structures up by name: a Python handle of a removed structure must never be touched
     missing = [n for n in reg.structures if not ps.has_surface_mesh(n)]
     if missing:
         raise ValueError(f"cannot render: structure(s) {missing} are no longer registered in polyscope")
-    others = (ps.get_surface_mesh(n) for n in sorted(_REGISTERED - set(reg.structures)) if ps.has_surface_mesh(n))
+    others = (ps.get_surface_mesh(n) for n in sorted(set(_REGISTERED) - set(reg.structures))
+              if ps.has_surface_mesh(n))
     hidden = [s for s in others if s.is_enabled()]
     for s in hidden:
         s.set_enabled(False)
@@ -751,18 +753,41 @@ def _render(reg, path, size):
         ps.get_surface_mesh(n).set_enabled(True)
     try:
         if reg.bounds is not None:
-            # frame only this call's structures (hidden ones still count in polyscope's extents)
-            ps.set_automatically_compute_scene_extents(False)
-            ps.set_bounding_box(reg.bounds[0], reg.bounds[1])
-            ps.set_length_scale(0.5 * float(np.linalg.norm(reg.bounds[1] - reg.bounds[0])))
-        ps.reset_camera_to_home_view()
+            _frame(ps, reg.bounds, w, h)
+        else:
+            ps.reset_camera_to_home_view()
         ps.screenshot(path, transparent_bg=False)
     finally:
         for s in hidden:
             s.set_enabled(True)
         ps.set_automatically_compute_scene_extents(True)
+        ps.set_view_projection_mode(projection)
     reg.screenshot = path
     return path
+
+
+def _frame(ps, bounds, width, height, margin=0.04):
+    """Orthographic camera on +z (looking down -z, y up) framing the box ``bounds``:
+    its x or y extent, whichever is binding, fills the picture up to ``margin``.
+
+    Orthographic so that copies laid side by side are seen from the same
+    direction.  polyscope's own home view frames the bounding-box diagonal,
+    which leaves wide pictures mostly empty and crops tall objects.  In
+    polyscope's orthographic mode the visible half-height is
+    ``2 tan(fov/2) × length_scale`` (measured), so the length scale sets the zoom.
+    """
+    lo, hi = np.asarray(bounds[0], dtype=np.float64), np.asarray(bounds[1], dtype=np.float64)
+    centre, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+    diag = float(np.linalg.norm(hi - lo)) or 1.0
+    tan_v = np.tan(np.radians(ps.get_vertical_fov_degrees()) / 2.0)
+    half_height = (1.0 + margin) * max(half[1], half[0] * height / width, 1e-9 * diag)
+    scale = half_height / (2.0 * tan_v)
+    ps.set_automatically_compute_scene_extents(False)   # hidden structures must not count
+    ps.set_bounding_box(lo, hi)
+    ps.set_length_scale(scale)
+    ps.set_view_projection_mode("orthographic")
+    # clip planes are multiples of the length scale: keep the camera just in front of the box
+    ps.look_at(centre + np.array([0.0, 0.0, half[2] + 0.5 * scale]), centre)
 
 
 def screenshot(path, registration=None, *, size=(1024, 768)):
@@ -787,7 +812,11 @@ def screenshot(path, registration=None, *, size=(1024, 768)):
     """
     if registration is None:
         import polyscope as ps
-        registration = Registration(structures={n: None for n in _REGISTERED if ps.has_surface_mesh(n)})
+        names = [n for n in _REGISTERED if ps.has_surface_mesh(n)]
+        registration = Registration(structures={n: None for n in names})
+        if names:
+            boxes = np.stack([_REGISTERED[n] for n in names])
+            registration.bounds = np.stack([boxes[:, 0].min(axis=0), boxes[:, 1].max(axis=0)])
     elif isinstance(registration, (list, tuple)):
         registration = merge(*registration)
     return _render(registration, path, size)
