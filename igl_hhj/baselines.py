@@ -115,29 +115,60 @@ def _ordered(name, location, k1, k2, H, K, d1, d2, bad):
 
 
 # --------------------------------------------------------------------------- HHJ
-def hhj_vertex(V, F, **kwargs):
+def _given_shape_operator(mesh, S, kwargs):
+    """Check a precomputed S_h (then no solver/boundary keywords make sense)."""
+    if kwargs:
+        raise TypeError(f"boundary/solver keywords {sorted(kwargs)} cannot be combined with a "
+                        "precomputed shape_operator")
+    S = np.asarray(S, dtype=np.float64)
+    if S.shape != (mesh.n_faces, 3, 3):
+        raise ValueError(f"shape_operator must have shape ({mesh.n_faces}, 3, 3), got {S.shape}")
+    return S
+
+
+def hhj_vertex(V, F, *, shape_operator=None, **kwargs):
     """HHJ drop-in at the vertices (:func:`igl_hhj.curvature.principal_curvature`).
+
+    Parameters
+    ----------
+    shape_operator : (#F, 3, 3), optional, a precomputed S_h (skips the solve).
+    **kwargs : boundary data / solver, see :func:`igl_hhj.shape_operator`.
 
     Returns
     -------
     CurvatureEstimate, location "vertex": k1, k2, H = (k1+k2)/2, K = k1 k2, d1, d2.
     """
-    from .curvature import principal_curvature
-    PD1, PD2, PV1, PV2, bad = principal_curvature(V, F, **kwargs)
+    from .curvature import principal_curvature, vertex_principal_curvature, vertex_shape_operator
+    if shape_operator is None:
+        PD1, PD2, PV1, PV2, bad = principal_curvature(V, F, **kwargs)
+    else:
+        mesh = as_mesh(V, F)
+        Sv, N = vertex_shape_operator(mesh, _given_shape_operator(mesh, shape_operator, kwargs))
+        PD1, PD2, PV1, PV2 = vertex_principal_curvature(mesh, Sv, N)
+        bad = np.flatnonzero(~mesh.referenced_vertices)
     return _ordered("hhj_vertex", "vertex", PV1, PV2, 0.5 * (PV1 + PV2), PV1 * PV2, PD1, PD2, bad)
 
 
-def hhj_face(V, F, **kwargs):
+def hhj_face(V, F, *, shape_operator=None, **kwargs):
     """Walker's HHJ shape operator S_h per face (eq. 5.12/5.14).
+
+    Parameters
+    ----------
+    shape_operator : (#F, 3, 3), optional, a precomputed S_h (skips the solve).
+    **kwargs : boundary data / solver, see :func:`igl_hhj.shape_operator`.
 
     Returns
     -------
     CurvatureEstimate, location "face": eigenvalues/vectors of S_h in the face
     plane, ``H = tr(S_h)/2``, ``K = det(S_h + ν_T ⊗ ν_T)`` (Walker eq. 6.1).
     """
-    from .curvature import principal_from_shape_operator, shape_operator
+    from .curvature import principal_from_shape_operator
+    from .curvature import shape_operator as solve_shape_operator
     mesh = as_mesh(V, F)
-    S = shape_operator(mesh.V, mesh.F, **kwargs)
+    if shape_operator is None:
+        S = solve_shape_operator(mesh.V, mesh.F, **kwargs)
+    else:
+        S = _given_shape_operator(mesh, shape_operator, kwargs)
     nu = mesh.face_normals
     d1, d2, k1, k2 = principal_from_shape_operator(S, nu)
     H = 0.5 * np.trace(S, axis1=1, axis2=2)

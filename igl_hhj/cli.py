@@ -201,13 +201,20 @@ def _curvature(args):
     t_read = time.perf_counter() - t
     large = mesh.n_faces > LARGE_MESH_FACES and not args.quiet
     keep_S = args.method == "hhj" and args.out is not None and Path(args.out).suffix.lower() == ".npz"
-    n_stages = 2 + (args.out is not None) + keep_S + (args.screenshot is not None)
+    n_stages = 2 + keep_S + (args.out is not None) + (args.screenshot is not None)
     stages = _Stages(n_stages, large)
     stages.done(f"reading and validating {mesh.n_faces} faces", t_read)
 
     t = time.perf_counter()
-    est = stages.run(f"{METHOD_LABELS[args.method]} ({per})",
-                     baselines.estimate, ESTIMATORS[args.method, per], mesh.V, mesh.F)
+    S = None
+    if keep_S:        # solve once, keep S_h for the npz, derive the curvatures from it
+        from .curvature import shape_operator
+        S = stages.run(f"{METHOD_LABELS[args.method]} (shape operator)", shape_operator, mesh.V, mesh.F)
+        hhj = baselines.hhj_face if per == "face" else baselines.hhj_vertex
+        est = stages.run(f"curvatures ({per})", hhj, mesh.V, mesh.F, shape_operator=S)
+    else:
+        est = stages.run(f"{METHOD_LABELS[args.method]} ({per})",
+                         baselines.estimate, ESTIMATORS[args.method, per], mesh.V, mesh.F)
     dt = time.perf_counter() - t
 
     print(f"{args.mesh}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, "
@@ -224,10 +231,6 @@ def _curvature(args):
               f"{why[args.method]}")
 
     if args.out is not None:
-        S = None
-        if keep_S:     # the estimators do not return S_h: one more solve for the npz
-            from .curvature import shape_operator
-            S = stages.run("HHJ shape operator S for the npz", shape_operator, mesh.V, mesh.F)
         _write(stages, args, mesh, est, S)
 
     if args.screenshot is not None or args.view:

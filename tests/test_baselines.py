@@ -236,3 +236,19 @@ def test_compare_estimators_quick_run(tmp_path):
         run(tmp_path, quick=True, estimators=["nope"])
     with pytest.raises(ValueError, match="unknown cases"):
         run(tmp_path, quick=True, cases=["nope"], do_speed=False, real=False)
+
+
+def test_hhj_estimates_from_a_precomputed_shape_operator():
+    """Passing S_h skips the solve and gives exactly the values of the solving path."""
+    from igl_hhj import shape_operator
+    from igl_hhj.surfaces.meshing import ellipsoid_coarse
+    V, F = ellipsoid_coarse(subdivisions=2)
+    S = shape_operator(V, F, solver="direct")
+    for fn in (B.hhj_face, B.hhj_vertex):
+        a, b = fn(V, F, solver="direct"), fn(V, F, shape_operator=S)
+        for q in ("k1", "k2", "H", "K"):
+            np.testing.assert_allclose(getattr(b, q), getattr(a, q), rtol=1e-12, atol=1e-12)
+        with pytest.raises(ValueError, match="shape_operator must have shape"):
+            fn(V, F, shape_operator=S[:-1])
+        with pytest.raises(TypeError, match="cannot be combined"):
+            fn(V, F, shape_operator=S, solver="cg")
