@@ -11,8 +11,11 @@ Submodules (imported on first use): :mod:`igl_hhj.regge` (Regge metrics and
 lifted distributional Gauss curvature), :mod:`igl_hhj.biharmonic` (mixed P1
 biharmonic solver, also as :func:`biharmonic_solve`), :mod:`igl_hhj.baselines`
 (libigl, Heine and pymeshlab estimators behind one interface),
-:mod:`igl_hhj.viewer` (polyscope), :mod:`igl_hhj.surfaces` (exact test
-surfaces and mesh sequences), :mod:`igl_hhj.benchmarks`.
+:mod:`igl_hhj.viewer` (polyscope viewers and headless screenshots),
+:mod:`igl_hhj.mesh_io` (guarded mesh reading, curvature output files),
+:mod:`igl_hhj.mesh_report` (what a mesh is made of and whether igl_hhj accepts it),
+:mod:`igl_hhj.surfaces` (exact test surfaces and mesh sequences), :mod:`igl_hhj.benchmarks`,
+:mod:`igl_hhj.cli` (the ``igl-hhj`` command).
 """
 import importlib
 
@@ -30,7 +33,7 @@ from .mesh import TriangleMesh, validate_mesh
 __version__ = "0.1.0"
 
 _LAZY_MODULES = {"regge", "biharmonic", "baselines", "viewer", "surfaces", "benchmarks",
-                 "hhj", "mesh", "convergence", "cli"}
+                 "hhj", "mesh", "convergence", "cli", "mesh_io", "mesh_report"}
 _LAZY_ATTRS = {"biharmonic_solve": "biharmonic", "BiharmonicSolver": "biharmonic"}
 
 __all__ = [
