@@ -123,7 +123,8 @@ def init(backend="auto"):
     Parameters
     ----------
     backend : str
-        ``"auto"`` keeps whatever backend is running (or lets polyscope choose);
+        ``"auto"`` keeps whatever backend is running (or lets polyscope choose,
+        falling back to headless EGL without a display);
         ``"openGL3_egl"`` renders without a display; ``"openGL_mock"`` renders
         nothing (unit tests).  Asking for a backend other than the running one
         shuts polyscope down (dropping every structure) and restarts it.
@@ -142,6 +143,9 @@ def init(backend="auto"):
         _REGISTERED.clear()
     # Without this a failed backend (e.g. EGL libraries missing) crashes the interpreter.
     ps.set_errors_throw_exceptions(True)
+    # "auto" without a display falls back to headless EGL: registering and
+    # screenshots work everywhere, show() says that there is no window.
+    ps.set_allow_headless_backends(True)
     try:
         ps.init(backend)
     except Exception as exc:
@@ -652,7 +656,7 @@ def register_regge_curvature(V, F, *, boundary="natural", mass="consistent", com
 
 
 def register_scalars(V, F, fields, *, name="mesh", enabled=None, shared_range=False, symmetric=True, robust=None,
-                     cmap="coolwarm", offset=None, screenshot=None, size=(1024, 768)):
+                     cmap="coolwarm", vminmax=None, offset=None, screenshot=None, size=(1024, 768)):
     """Register arbitrary per-vertex / per-face scalar fields (errors, indicators, ...).
 
     Parameters
@@ -662,6 +666,8 @@ def register_scalars(V, F, fields, *, name="mesh", enabled=None, shared_range=Fa
     enabled : quantity name shown first (default: the first one).
     shared_range : bool, one colour range for all fields (else one each).
     symmetric, robust, cmap : colour range and map (:func:`color_range`).
+    vminmax : (lo, hi), optional, one explicit range for every field (e.g. the
+        same range as another structure's picture).
     offset : (3,) translation of the structure (to lay out several pictures).
 
     Returns
@@ -688,7 +694,13 @@ def register_scalars(V, F, fields, *, name="mesh", enabled=None, shared_range=Fa
     Vs = mesh.V if offset is None else mesh.V + np.asarray(offset, dtype=np.float64).reshape(3)
     ps = _polyscope_for(screenshot)
     reg = Registration()
-    common = color_range(*vals.values(), symmetric=symmetric, robust=robust) if shared_range else None
+    if vminmax is not None:
+        lo, hi = (float(x) for x in vminmax)
+        if not lo < hi:
+            raise ValueError(f"vminmax must be (lo, hi) with lo < hi, got {vminmax!r}")
+        common = (lo, hi)
+    else:
+        common = color_range(*vals.values(), symmetric=symmetric, robust=robust) if shared_range else None
     _surface(ps, reg, name, Vs, mesh.F)
     for k, x in vals.items():
         reg.ranges[k] = common or color_range(x, symmetric=symmetric, robust=robust)

@@ -96,7 +96,7 @@ def test_demo_is_headless_safe(tmp_path, monkeypatch, capsys):
 
     def unavailable(*args, **kwargs):
         raise viewer.ViewerUnavailable("polyscope could not initialise backend 'openGL3_egl': no EGL")
-    monkeypatch.setattr(viewer, "register_comparison", unavailable)
+    monkeypatch.setattr(viewer, "register_scalars", unavailable)
     monkeypatch.chdir(tmp_path)
     assert cli.main(["demo", "--levels", "1"]) == 0
     cap = capsys.readouterr()

@@ -152,6 +152,10 @@ def test_register_hessian_biharmonic_regge_scalars(mock, sphere):
     assert s.quantities[("sc", "x")].defined_on == "vertices"
     assert s.quantities[("sc", "area")].defined_on == "faces"
     assert s.bounds[0, 0] == pytest.approx(V[:, 0].min() + 3)
+    fixed = viewer.register_scalars(V, F, {"x": V[:, 0], "y": V[:, 1]}, name="fx", vminmax=(0, 5))
+    assert {q.vminmax for q in fixed.quantities.values()} == {(0.0, 5.0)}
+    with pytest.raises(ValueError, match="lo < hi"):
+        viewer.register_scalars(V, F, {"x": V[:, 0]}, vminmax=(1, 1))
 
 
 def test_color_range():
