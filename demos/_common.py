@@ -87,6 +87,20 @@ def print_table(title, header, rows):
     sys.stdout.flush()
 
 
+def print_eoc_table(title, rows, series):
+    """Table of errors per refinement level with their EOCs.
+
+    rows : list of dicts with "faces" and "h" (longest edge), one per level.
+    series : list of (label, [error per level]).
+    """
+    hs = [r["h"] for r in rows]
+    rates = [eocs(values, hs) for _, values in series]
+    header = ["level", "faces", "h"] + [x for label, _ in series for x in (label, "EOC")]
+    body = [[k, r["faces"], r["h"]] + [x for (_, values), e in zip(series, rates) for x in (values[k], e[k])]
+            for k, r in enumerate(rows)]
+    print_table(title, header, body)
+
+
 # --------------------------------------------------------------------------- viewer
 def start_viewer(args):
     """The viewer module, with polyscope started for headless rendering
@@ -111,7 +125,10 @@ def finish(viewer, args, registrations):
             fail(str(exc).splitlines()[0], code=1)
         print(f"\nwrote {args.screenshot} ({args.size[0]} x {args.size[1]})")
     else:
-        viewer.show()
+        try:
+            viewer.show()
+        except viewer.ViewerUnavailable as exc:
+            fail(f"{str(exc).splitlines()[0]} (use --screenshot out.png for headless rendering)", code=1)
 
 
 def framed_screenshot(viewer, path, registrations, size, supersample=2, margin=0.04):
@@ -180,6 +197,16 @@ def error_range(*arrays, robust=1.0):
     from igl_hhj import viewer
     _, hi = viewer.color_range(*arrays, symmetric=False, robust=robust)
     return 0.0, max(hi, 1e-300)
+
+
+def rotation(spin=0.0, tilt=-60.0):
+    """(3, 3) rotation by ``spin`` degrees about z, then ``tilt`` degrees about x:
+    applied to a surface around the z axis (``V @ R.T``) it is seen obliquely
+    from above by polyscope's default camera (looking down -z, y up)."""
+    c, s = np.cos(np.radians(spin)), np.sin(np.radians(spin))
+    Rz = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    c, s = np.cos(np.radians(tilt)), np.sin(np.radians(tilt))
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]]) @ Rz
 
 
 def grid_offsets(V, n_cols, n_rows, gap=0.15):

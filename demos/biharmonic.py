@@ -47,18 +47,10 @@ def problem(bc):
     """(problem, extra solve kwargs, display rotation) for ``bc``."""
     from igl_hhj.surfaces.biharmonic_problems import Hemisphere, LanternProblem, SphereHarmonicsProblem
     if bc == "clamped":
-        return Hemisphere(), {}, rotation(0.0, -60.0)
+        return Hemisphere(), {}, _common.rotation(0.0, -60.0)
     if bc == "navier":
-        return LanternProblem("navier"), {}, rotation(20.0, -75.0)
-    return SphereHarmonicsProblem(bc="closed"), {"project_mean": True}, rotation(30.0, -60.0)
-
-
-def rotation(spin, tilt):
-    """Rotation by ``spin`` degrees about z, then ``tilt`` degrees about x."""
-    c, s = np.cos(np.radians(spin)), np.sin(np.radians(spin))
-    Rz = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-    c, s = np.cos(np.radians(tilt)), np.sin(np.radians(tilt))
-    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]]) @ Rz
+        return LanternProblem("navier"), {}, _common.rotation(20.0, -75.0)
+    return SphereHarmonicsProblem(bc="closed"), {"project_mean": True}, _common.rotation(30.0, -60.0)
 
 
 def measure(prob, kwargs, n_levels):
@@ -74,13 +66,9 @@ def measure(prob, kwargs, n_levels):
 
 def table(rows, prob, bc):
     from igl_hhj.benchmarks.biharmonic_convergence import PAPER
-    hs = [r["h"] for r in rows]
-    e1 = _common.eocs([r["u1_L2"] for r in rows], hs)
-    e2 = _common.eocs([r["u2_L2"] for r in rows], hs)
-    body = [[k, r["faces"], r["h"], r["u1_L2"], e1[k], r["u1_L2_rel"], r["u2_L2"], e2[k]]
-            for k, r in enumerate(rows)]
-    _common.print_table(f"{prob.name}, bc={bc}: L2 errors of the mixed P1 solution",
-                        ["level", "faces", "h", "‖u1 - u‖", "EOC", "relative", "‖u2 + Δu‖", "EOC"], body)
+    _common.print_eoc_table(f"{prob.name}, bc={bc}: L2 errors of the mixed P1 solution", rows,
+                            [("‖u1 - u‖", [r["u1_L2"] for r in rows]),
+                             ("‖u2 + Δu‖", [r["u2_L2"] for r in rows])])
     paper = PAPER[PAPER_KEY[bc]]
     note = " (the paper's lantern is clamped; this Navier lantern is ours)" if bc == "navier" else ""
     print(f"paper 001{note}: rates u1 L2 {paper['u1_L2']}, u2 L2 {paper['u2_L2']}; {paper['observed']}")

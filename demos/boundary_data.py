@@ -79,23 +79,9 @@ def measure(surface, seq):
 
 
 def tables(rows, name):
-    hs = [r["h"] for r in rows]
     for key, title in (("S", "L2 error ‖S - S_h‖"), ("S_inf", "max error |S - S_h| over face corners")):
-        cols = {lab: [r["err"][lab][key] for r in rows] for lab, _ in KINDS}
-        rates = {lab: _common.eocs(cols[lab], hs) for lab in cols}
-        header = ["level", "faces", "h"] + [x for lab, _ in KINDS for x in (lab, "EOC")]
-        body = [[k, r["faces"], r["h"]] + [x for lab, _ in KINDS for x in (cols[lab][k], rates[lab][k])]
-                for k, r in enumerate(rows)]
-        _common.print_table(f"{name}: {title}", header, body)
-
-
-def view_rotation(spin, tilt):
-    """Rotation by ``spin`` degrees about z, then ``tilt`` degrees about x (a view from above)."""
-    c, s = np.cos(np.radians(spin)), np.sin(np.radians(spin))
-    Rz = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-    c, s = np.cos(np.radians(tilt)), np.sin(np.radians(tilt))
-    Rx = np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
-    return Rx @ Rz
+        _common.print_eoc_table(f"{name}: {title}", rows, [(lab, [r["err"][lab][key] for r in rows])
+                                                            for lab, _ in KINDS])
 
 
 VIEW = {"saddle": (-30.0, -20.0), "dumbbell": (0.0, -25.0)}
@@ -104,7 +90,7 @@ VIEW = {"saddle": (-30.0, -20.0), "dumbbell": (0.0, -25.0)}
 def show(rows, args):
     viewer = _common.start_viewer(args)
     last = rows[-1]
-    V = last["mesh"].V @ view_rotation(*VIEW[args.surface]).T
+    V = last["mesh"].V @ _common.rotation(*VIEW[args.surface]).T
     V = V - V.mean(axis=0)
     vrange = _common.error_range(*last["field"].values(), robust=1.0)
     offsets = _common.grid_offsets(V, len(KINDS), 1)[0]

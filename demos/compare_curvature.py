@@ -53,9 +53,7 @@ def generated(name, levels=None):
     return jitter_tangentially(V, F, s, amount=0.3, seed=1), F, s
 
 
-# display of the generated surfaces: tilted 60 degrees about x (curvature does not change)
-_C, _S = np.cos(np.radians(-60)), np.sin(np.radians(-60))
-TILT = np.array([[1.0, 0.0, 0.0], [0.0, _C, -_S], [0.0, _S, _C]])
+TILT = _common.rotation(0.0, -60.0)  # generated surfaces: seen obliquely from above
 
 
 def estimates(V, F, per):

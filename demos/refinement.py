@@ -67,14 +67,8 @@ def measure(levels, surface):
 
 
 def table(rows):
-    hs = [r["h"] for r in rows]
-    cols = {lab: [r["err"][lab] for r in rows] for lab, _ in METHODS}
-    rates = {lab: _common.eocs(cols[lab], hs) for lab in cols}
-    header = ["level", "faces", "h"] + [x for lab, _ in METHODS for x in (f"{lab} rel. L2(H)", "EOC")]
-    body = [[k, r["faces"], r["h"]] + [x for lab, _ in METHODS for x in (cols[lab][k], rates[lab][k])]
-            for k, r in enumerate(rows)]
-    _common.print_table("Relative L2 error of the mean curvature H on re-jittered ellipsoid meshes", header, body)
-    return cols, rates
+    _common.print_eoc_table("Relative L2 error of the mean curvature H on re-jittered ellipsoid meshes", rows,
+                            [(f"{lab} rel. L2(H)", [r["err"][lab] for r in rows]) for lab, _ in METHODS])
 
 
 def plot(rows, path):

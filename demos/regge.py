@@ -42,8 +42,7 @@ import numpy as np
 
 import _common
 
-_C, _S = np.cos(np.radians(-60)), np.sin(np.radians(-60))
-TILT = np.array([[1.0, 0.0, 0.0], [0.0, _C, -_S], [0.0, _S, _C]])
+TILT = _common.rotation(0.0, -60.0)  # generated surfaces: seen obliquely from above
 
 
 def torus_levels(n_levels, jitter=0.0, seed=10):

@@ -185,3 +185,15 @@ def test_regge_mesh_file(tmp_path, requires_egl):
     _, body = table_rows(out, "Gauss–Bonnet")
     total, two_pi_chi = number(body[0][3]), number(body[0][4])
     assert abs(total - two_pi_chi) < 1e-8 * max(1.0, abs(two_pi_chi))
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="display detection differs off Linux")
+def test_interactive_without_display_is_a_one_line_error(requires_egl):
+    """No --screenshot and no display: polyscope falls back to a windowless backend;
+    the demo says so in one line (exit 1) instead of a traceback."""
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    res = subprocess.run([sys.executable, "demos/regge.py", "--levels", "2"], cwd=ROOT, capture_output=True,
+                         text=True, timeout=TIMEOUT, env=env)
+    assert res.returncode == 1, res.stderr
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and "--screenshot" in lines[0], res.stderr
