@@ -120,7 +120,7 @@ def finish(viewer, args, registrations):
     """Write the screenshot of ``registrations`` or open the interactive viewer."""
     if args.screenshot:
         try:
-            framed_screenshot(viewer, args.screenshot, list(registrations), tuple(args.size))
+            viewer.screenshot(args.screenshot, list(registrations), size=tuple(args.size))
         except (ValueError, viewer.ViewerUnavailable) as exc:
             fail(str(exc).splitlines()[0], code=1)
         print(f"\nwrote {args.screenshot} ({args.size[0]} x {args.size[1]})")
@@ -131,52 +131,17 @@ def finish(viewer, args, registrations):
             fail(f"{str(exc).splitlines()[0]} (use --screenshot out.png for headless rendering)", code=1)
 
 
-def framed_screenshot(viewer, path, registrations, size, supersample=2, margin=0.04):
-    """``viewer.screenshot`` with the picture filling the frame.
-
-    polyscope's home view fits the bounding-box diagonal into the window
-    height, which leaves wide layouts (copies side by side) small in the
-    middle.  This renders at ``supersample`` × ``size``, crops to the drawn
-    pixels plus ``margin`` at the aspect ratio of ``size``, and resamples to
-    ``size`` (Pillow, which matplotlib depends on; without it the plain
-    screenshot is kept).
-    """
-    W, H = (int(x) for x in size)
-    try:
-        from PIL import Image
-    except ImportError:  # pragma: no cover - Pillow comes with matplotlib
-        return viewer.screenshot(path, registrations, size=(W, H))
-    viewer.screenshot(path, registrations, size=(supersample * W, supersample * H))
-    with Image.open(path) as im:
-        img = im.convert("RGB")
-    a = np.asarray(img).astype(np.int16)
-    drawn = np.abs(a - a[0, 0]).sum(axis=2) > 6                    # differs from the background colour
-    if not drawn.any():
-        img.resize((W, H), Image.LANCZOS).save(path)
-        return path
-    rows, cols = np.flatnonzero(drawn.any(axis=1)), np.flatnonzero(drawn.any(axis=0))
-    y0, y1, x0, x1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
-    cw, ch = (x1 - x0) * (1 + 2 * margin), (y1 - y0) * (1 + 2 * margin)
-    cw, ch = max(cw, ch * W / H), max(ch, cw * H / W)               # aspect of the requested size
-    cx, cy = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
-    box = tuple(int(round(v)) for v in (cx - cw / 2, cy - ch / 2, cx + cw / 2, cy + ch / 2))
-    canvas = Image.new("RGB", (box[2] - box[0], box[3] - box[1]), tuple(int(c) for c in a[0, 0]))
-    canvas.paste(img, (-box[0], -box[1]))                           # crop, padding with background
-    canvas.resize((W, H), Image.LANCZOS).save(path)
-    return path
-
-
 def register_field(viewer, V, F, label, values, vrange, *, name, offset=None, cmap="viridis"):
-    """One structure carrying one scalar field coloured on the given range ``vrange``."""
-    reg = viewer.register_scalars(V, F, {label: values}, name=name, offset=offset, cmap=cmap,
-                                  symmetric=False)
-    return set_range(reg, vrange)
+    """One structure carrying one scalar field coloured on the given range ``vrange``
+    (several of them laid side by side share one range)."""
+    return viewer.register_scalars(V, F, {label: values}, name=name, offset=offset, cmap=cmap,
+                                   vminmax=tuple(vrange))
 
 
 def set_range(reg, vrange):
     """Put every scalar quantity of ``reg`` on the colour range ``vrange`` (kept enabled state).
 
-    The viewer's ``register_*`` functions compute each call's range from its
+    ``viewer.register_regge_curvature`` computes each call's range from its
     own values; pictures laid side by side need one common range, so the
     quantities are re-added here with ``vrange`` and the Registration record
     is updated to match.
