@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from dataclasses import replace
 
 import numpy as np
 
@@ -136,24 +135,6 @@ def register_field(viewer, V, F, label, values, vrange, *, name, offset=None, cm
     (several of them laid side by side share one range)."""
     return viewer.register_scalars(V, F, {label: values}, name=name, offset=offset, cmap=cmap,
                                    vminmax=tuple(vrange))
-
-
-def set_range(reg, vrange):
-    """Put every scalar quantity of ``reg`` on the colour range ``vrange`` (kept enabled state).
-
-    ``viewer.register_regge_curvature`` computes each call's range from its
-    own values; pictures laid side by side need one common range, so the
-    quantities are re-added here with ``vrange`` and the Registration record
-    is updated to match.
-    """
-    vrange = tuple(float(x) for x in vrange)
-    items = sorted(((k, q) for k, q in reg.quantities.items() if q.kind == "scalar"), key=lambda kq: kq[1].enabled)
-    for (sname, qname), q in items:                         # the enabled one last, as the viewer does
-        reg.structures[sname].add_scalar_quantity(qname, np.nan_to_num(q.values), defined_on=q.defined_on,
-                                                  vminmax=vrange, cmap=q.cmap, enabled=q.enabled)
-        reg.quantities[(sname, qname)] = replace(q, vminmax=vrange)
-    reg.ranges = {k: vrange for k in reg.ranges}
-    return reg
 
 
 def error_range(*arrays, robust=1.0):

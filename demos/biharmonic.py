@@ -84,8 +84,8 @@ def show(rows, prob, R, args):
     ext = V.max(axis=0) - V.min(axis=0)
     left = viewer.register_biharmonic(V, last["F"], last["u1"], last["u2"], exact=u, f=f, name="u1",
                                       enabled="u1")
-    right = viewer.register_biharmonic(V + [1.15 * ext[0], 0.0, 0.0], last["F"], last["u1"], last["u2"],
-                                       exact=u, f=f, name="error u1 - u", enabled="error")
+    right = viewer.register_biharmonic(V, last["F"], last["u1"], last["u2"], exact=u, f=f, name="error u1 - u",
+                                       enabled="error", offset=(1.15 * ext[0], 0.0, 0.0))
     lo, hi = left.ranges["u1"]
     elo, ehi = right.ranges["error"]
     print(f"colour ranges: u1 and u [{lo:.3g}, {hi:.3g}]; error u1 - u [{elo:.3g}, {ehi:.3g}]")

@@ -267,14 +267,30 @@ def curvature_estimate(V, F, *, method="hhj", per="face", **kwargs):
     return (baselines.libigl_quadric if method == "igl" else baselines.heine)(V, F, **kwargs)
 
 
+def _explicit_range(vminmax):
+    """A user-given (lo, hi) colour range, checked."""
+    try:
+        lo, hi = (float(x) for x in vminmax)
+    except (TypeError, ValueError):
+        raise ValueError(f"a colour range must be (lo, hi), got {vminmax!r}") from None
+    if not lo < hi:
+        raise ValueError(f"a colour range must be (lo, hi) with lo < hi, got {vminmax!r}")
+    return lo, hi
+
+
 def _check(value, name, choices):
     if value not in choices:
         raise ValueError(f"{name} must be one of {choices}, got {value!r}")
 
 
 # --------------------------------------------------------------------------- registration helpers
-def _surface(ps, reg, name, V, F):
-    """Register a surface mesh under ``name``, replacing one of the same name."""
+def _surface(ps, reg, name, V, F, offset=None):
+    """Register a surface mesh under ``name`` (translated by ``offset``), replacing one of the same name."""
+    if offset is not None:
+        off = np.asarray(offset, dtype=np.float64)
+        if off.shape != (3,) or not np.all(np.isfinite(off)):
+            raise ValueError(f"offset must be 3 finite numbers, got {offset!r}")
+        V = V + off
     if ps.has_surface_mesh(name):
         ps.remove_surface_mesh(name)
     s = ps.register_surface_mesh(name, V, F, color=(0.75, 0.75, 0.75))  # grey: no quantity shown
@@ -361,7 +377,7 @@ def _finish(reg, screenshot, size):
 # --------------------------------------------------------------------------- curvature
 def register_curvature(V, F, estimate=None, *, method="hhj", per="both", name="mesh", enabled="H",
                        directions=True, show_directions=False, symmetric=True, robust=None, cmap="coolwarm", ranges=None,
-                       direction_scale=0.5, screenshot=None, size=(1024, 768), **estimator_kwargs):
+                       direction_scale=0.5, offset=None, screenshot=None, size=(1024, 768), **estimator_kwargs):
     """Register a mesh with its curvature: κ1, κ2, H, K (scalars) and principal directions.
 
     Parameters
@@ -384,6 +400,7 @@ def register_curvature(V, F, estimate=None, *, method="hhj", per="both", name="m
     ranges : dict, optional, explicit ``{quantity: (lo, hi)}`` overriding the
         computed ranges (e.g. to match another picture).
     direction_scale : float, direction length in units of the local mean edge length.
+    offset : (3,), optional translation of the structure (to lay out several pictures).
     screenshot : path, optional: render headless to this PNG (see :func:`screenshot`).
     size : (width, height) of the screenshot in pixels.
     **estimator_kwargs : passed to the estimator (boundary data, ``radius``...).
@@ -412,8 +429,10 @@ def register_curvature(V, F, estimate=None, *, method="hhj", per="both", name="m
     reg.ranges = {q: color_range(*(getattr(e, q) for e in ests), symmetric=symmetric, robust=robust)
                   for q in QUANTITIES}
     if ranges:
-        reg.ranges.update({k: tuple(v) for k, v in ranges.items()})
-    _surface(ps, reg, name, mesh.V, mesh.F)
+        for k in ranges:
+            _check(k, "ranges key", QUANTITIES)
+        reg.ranges.update({k: _explicit_range(v) for k, v in ranges.items()})
+    _surface(ps, reg, name, mesh.V, mesh.F, offset)
     for i, (est, tag) in enumerate(zip(ests, tags)):
         _add_estimate(reg, name, mesh, est, tag, reg.ranges, cmap, directions, direction_scale,
                       enabled=enabled if i == 0 else None, show_directions=show_directions and i == 0)
@@ -498,7 +517,7 @@ def register_comparison(V, F, *, hhj=None, libigl=None, per="face", layout="copy
 # --------------------------------------------------------------------------- other fields
 def register_hessian(V, F, w, *, boundary_gradient=None, name="mesh", label="w", enabled="trace",
                      directions=True, symmetric=True, robust=None, cmap="coolwarm", direction_scale=0.5,
-                     screenshot=None, size=(1024, 768)):
+                     offset=None, screenshot=None, size=(1024, 768)):
     """Register a P1 function ``w`` and its HHJ surface Hessian (Walker eq. 4.9).
 
     Parameters
@@ -507,6 +526,7 @@ def register_hessian(V, F, w, *, boundary_gradient=None, name="mesh", label="w",
     boundary_gradient : optional clamped data, see :func:`igl_hhj.surface_hessian`.
     label : str, name of the function in the quantity names.
     enabled : {"w", "lambda1", "lambda2", "trace", "norm"}, quantity shown first.
+    offset : (3,), optional translation of the structure.
 
     Registered (on structure ``name``): ``w`` (vertices, viridis), the
     eigenvalues λ1 ≥ λ2 of the tangential Hessian and its trace (the surface
@@ -537,7 +557,7 @@ def register_hessian(V, F, w, *, boundary_gradient=None, name="mesh", label="w",
                   "lambda": color_range(l1, l2, symmetric=symmetric, robust=robust),
                   "trace": color_range(tr, symmetric=symmetric, robust=robust),
                   "norm": color_range(nrm, symmetric=False, robust=robust)}
-    _surface(ps, reg, name, mesh.V, mesh.F)
+    _surface(ps, reg, name, mesh.V, mesh.F, offset)
     names = {"w": label, "lambda1": f"Hess {label} lambda1", "lambda2": f"Hess {label} lambda2",
              "trace": f"Hess {label} trace (surface Laplacian)", "norm": f"|Hess {label}|"}
     for key, vals, where, rng, cm in (("w", wv, "vertices", "w", "viridis"),
@@ -554,7 +574,7 @@ def register_hessian(V, F, w, *, boundary_gradient=None, name="mesh", label="w",
 
 
 def register_biharmonic(V, F, u1, u2=None, *, exact=None, f=None, name="mesh", enabled="u1", symmetric=None,
-                        robust=None, screenshot=None, size=(1024, 768)):
+                        robust=None, ranges=None, offset=None, screenshot=None, size=(1024, 768)):
     """Register a mixed-P1 biharmonic solution (Stein et al.): ``u1 ≈ u``, ``u2 ≈ -Δu``.
 
     Parameters
@@ -566,6 +586,8 @@ def register_biharmonic(V, F, u1, u2=None, *, exact=None, f=None, name="mesh", e
     enabled : {"u1", "u2", "u", "error", "f"}
     symmetric : bool or None; None = symmetric (diverging map) when the values
         change sign, else a sequential ``viridis`` range.
+    ranges : dict, optional explicit ranges by key ("u1", "u2", "f", "error").
+    offset : (3,), optional translation of the structure.
 
     Returns
     -------
@@ -593,7 +615,7 @@ def register_biharmonic(V, F, u1, u2=None, *, exact=None, f=None, name="mesh", e
     _check(enabled, "enabled", tuple(fields))
     ps = _polyscope_for(screenshot)
     reg = Registration()
-    _surface(ps, reg, name, mesh.V, mesh.F)
+    _surface(ps, reg, name, mesh.V, mesh.F, offset)
     for key in ("u1", "u2", "f", "error"):
         if key not in fields:
             continue
@@ -602,7 +624,8 @@ def register_biharmonic(V, F, u1, u2=None, *, exact=None, f=None, name="mesh", e
         fin = fin[np.isfinite(fin)]
         signed = key == "error" or (fin.size > 0 and fin.min() < 0 < fin.max())
         sym = signed if symmetric is None else bool(symmetric)
-        reg.ranges[key] = color_range(*vals, symmetric=sym, robust=robust)
+        reg.ranges[key] = (_explicit_range(ranges[key]) if ranges and key in ranges
+                           else color_range(*vals, symmetric=sym, robust=robust))
         cm = "coolwarm" if sym else "viridis"
         for k in [key] + (["u"] if key == "u1" and "u" in fields else []):
             qname = {"u1": "u1 (approx. u)", "u2": "u2 (approx. -Laplacian u)", "u": "u exact",
@@ -612,8 +635,8 @@ def register_biharmonic(V, F, u1, u2=None, *, exact=None, f=None, name="mesh", e
 
 
 def register_regge_curvature(V, F, *, boundary="natural", mass="consistent", compare=True, name="mesh",
-                             enabled="K_h", symmetric=True, robust=None, cmap="coolwarm", screenshot=None,
-                             size=(1024, 768)):
+                             enabled="K_h", symmetric=True, robust=None, cmap="coolwarm", vminmax=None,
+                             offset=None, screenshot=None, size=(1024, 768)):
     """Register the Regge (degree-0, edge-length metric) Gauss curvature K_h (paper 004).
 
     Parameters
@@ -623,6 +646,9 @@ def register_regge_curvature(V, F, *, boundary="natural", mass="consistent", com
         (libigl ``gaussian_curvature`` / barycentric area, vertices) and the HHJ
         Gauss curvature ``det(S_h + ν⊗ν)`` (faces), all on K_h's colour range.
     enabled : {"K_h", "angle_defect", "hhj"}
+    vminmax : (lo, hi), optional explicit range (e.g. shared with other pictures);
+        default: :func:`color_range` of K_h.
+    offset : (3,), optional translation of the structure.
 
     Returns
     -------
@@ -648,8 +674,9 @@ def register_regge_curvature(V, F, *, boundary="natural", mass="consistent", com
         fields["hhj"] = ("HHJ Gauss K (faces)", face_gaussian_curvature(mesh.V, mesh.F), "faces")
     ps = _polyscope_for(screenshot)
     reg = Registration()
-    reg.ranges["K"] = color_range(Kh, symmetric=symmetric, robust=robust)
-    _surface(ps, reg, name, mesh.V, mesh.F)
+    reg.ranges["K"] = (_explicit_range(vminmax) if vminmax is not None
+                       else color_range(Kh, symmetric=symmetric, robust=robust))
+    _surface(ps, reg, name, mesh.V, mesh.F, offset)
     for key, (qname, vals, where) in fields.items():
         _scalar(reg, name, qname, vals, where, reg.ranges["K"], cmap, enabled=(key == enabled))
     return _finish(reg, screenshot, size)
@@ -691,17 +718,13 @@ def register_scalars(V, F, fields, *, name="mesh", enabled=None, shared_range=Fa
         vals[k] = x
     enabled = next(iter(vals)) if enabled is None else enabled
     _check(enabled, "enabled", tuple(vals))
-    Vs = mesh.V if offset is None else mesh.V + np.asarray(offset, dtype=np.float64).reshape(3)
     ps = _polyscope_for(screenshot)
     reg = Registration()
     if vminmax is not None:
-        lo, hi = (float(x) for x in vminmax)
-        if not lo < hi:
-            raise ValueError(f"vminmax must be (lo, hi) with lo < hi, got {vminmax!r}")
-        common = (lo, hi)
+        common = _explicit_range(vminmax)
     else:
         common = color_range(*vals.values(), symmetric=symmetric, robust=robust) if shared_range else None
-    _surface(ps, reg, name, Vs, mesh.F)
+    _surface(ps, reg, name, mesh.V, mesh.F, offset)
     for k, x in vals.items():
         reg.ranges[k] = common or color_range(x, symmetric=symmetric, robust=robust)
         _scalar(reg, name, k, x, where[k], reg.ranges[k], cmap, enabled=(k == enabled))

@@ -172,9 +172,11 @@ def test_biharmonic(tmp_path, requires_egl, bc):
 def test_regge(tmp_path, requires_egl):
     out = run_demo("regge", tmp_path, "--levels", "2")
     header, body = table_rows(out, "Gauss–Bonnet")
+    col = {name: i for i, name in enumerate(header)}
     for r in body:
-        assert abs(number(r[3]) - number(r[4])) < 1e-8     # Σ M K_h = 2πχ (torus: 0)
-        assert np.isfinite(number(r[5])) and np.isfinite(number(r[7]))
+        assert abs(number(r[col["Σ M K_h"]]) - number(r[col["2πχ"]])) < 1e-8     # Gauss–Bonnet (torus: 0)
+        assert np.isfinite(number(r[col["‖K_h - K‖ Regge"]])) and np.isfinite(number(r[col["‖κ_g - K‖ HHJ"]]))
+        assert 0 < number(r[col["min angle (°)"]]) < 60
 
 
 def test_regge_mesh_file(tmp_path, requires_egl):
@@ -182,8 +184,8 @@ def test_regge_mesh_file(tmp_path, requires_egl):
     if not path.exists():
         pytest.skip(f"{path} absent")
     out = run_demo("regge", tmp_path, str(path))
-    _, body = table_rows(out, "Gauss–Bonnet")
-    total, two_pi_chi = number(body[0][3]), number(body[0][4])
+    header, body = table_rows(out, "Gauss–Bonnet")
+    total, two_pi_chi = number(body[0][header.index("Σ M K_h")]), number(body[0][header.index("2πχ")])
     assert abs(total - two_pi_chi) < 1e-8 * max(1.0, abs(two_pi_chi))
 
 

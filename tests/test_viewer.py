@@ -158,6 +158,25 @@ def test_register_hessian_biharmonic_regge_scalars(mock, sphere):
         viewer.register_scalars(V, F, {"x": V[:, 0]}, vminmax=(1, 1))
 
 
+def test_offsets_and_explicit_ranges(mock, sphere):
+    V, F = sphere
+    shift = np.array([4.0, -1.0, 0.5])
+    regs = [viewer.register_curvature(V, F, name="c", offset=shift),
+            viewer.register_hessian(V, F, V[:, 0], name="h", offset=shift),
+            viewer.register_biharmonic(V, F, V[:, 0], name="b", offset=shift, ranges={"u1": (-3, 3)}),
+            viewer.register_regge_curvature(V, F, name="r", offset=shift, vminmax=(-2, 2))]
+    for reg in regs:
+        np.testing.assert_allclose(reg.bounds, np.stack([V.min(0), V.max(0)]) + shift)
+    assert regs[2].quantities[("b", "u1 (approx. u)")].vminmax == (-3.0, 3.0)
+    assert {q.vminmax for q in regs[3].quantities.values()} == {(-2.0, 2.0)}
+    with pytest.raises(ValueError, match="offset must be 3 finite numbers"):
+        viewer.register_regge_curvature(V, F, offset=(1, 2))
+    with pytest.raises(ValueError, match="lo < hi"):
+        viewer.register_regge_curvature(V, F, vminmax=(2, -2))
+    with pytest.raises(ValueError, match="ranges key must be one of"):
+        viewer.register_curvature(V, F, ranges={"k3": (0, 1)})
+
+
 def test_color_range():
     assert viewer.color_range(np.array([1.0, 2.0]), np.array([3.0]), symmetric=False) == (1.0, 3.0)
     assert viewer.color_range(np.array([1.0, 2.0, 3.0])) == (-3.0, 3.0)
