@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import MESH_DIR
+from conftest import MESH_DIR, require_egl
 
 ROOT = Path(__file__).resolve().parents[1]
 DEMOS = ["compare_curvature", "refinement", "boundary_data", "biharmonic", "regge"]
@@ -36,15 +36,10 @@ def run(args, timeout=TIMEOUT):
     return subprocess.run([sys.executable, *args], cwd=ROOT, capture_output=True, text=True, timeout=timeout)
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture
 def requires_egl():
-    """Skip when polyscope cannot open an EGL context, unless running in CI."""
-    probe = run(["-c", "import polyscope as ps; ps.init('openGL3_egl')"], timeout=60)
-    if probe.returncode != 0:
-        msg = f"EGL unavailable for polyscope: {probe.stderr.strip().splitlines()[-1:] or probe.stdout[-200:]}"
-        if os.environ.get("CI"):
-            pytest.fail(msg + " (CI is set: EGL must work; install libegl1 libegl-mesa0 libgl1-mesa-dri)")
-        pytest.skip(msg)
+    """Skip when polyscope cannot open EGL, unless $CI is set (conftest.require_egl)."""
+    require_egl()
 
 
 def table_rows(stdout, title_part):
