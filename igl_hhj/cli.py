@@ -163,7 +163,7 @@ def _demo(args):
         try:
             _demo_screenshot(V, F, surface, PV1, PV2, QV1, QV2, shot)
         except _viewer().ViewerUnavailable as exc:
-            print(f"igl-hhj: warning: no screenshot ({_first_line(exc)}); {EGL_HINT}", file=sys.stderr)
+            print(f"igl-hhj: warning: no screenshot ({_with_hint(exc)})", file=sys.stderr)
         else:
             print(f"\nwrote {shot}: |error of H| on the finest mesh, HHJ (left) and libigl (right), "
                   "one colour range")
@@ -181,6 +181,12 @@ def _demo_screenshot(V, F, surface, PV1, PV2, QV1, QV2, path):
                      vminmax=(0.0, top), cmap="viridis", offset=i * shift)
             for i, (k, e) in enumerate(err.items())]
     _quietly(viewer.screenshot, str(path), regs, size=(1600, 700))
+
+
+def _with_hint(exc):
+    """The viewer's message, with the EGL package hint unless it already has one."""
+    msg = _first_line(exc)
+    return msg if "libegl1" in msg else f"{msg}; {EGL_HINT}"
 
 
 def _first_line(exc):
@@ -262,7 +268,7 @@ def _curvature(args):
                 stages.run("screenshot", _quietly, viewer.register_curvature, mesh.V, mesh.F,
                            estimate=est, name=name, robust=robust, screenshot=str(args.screenshot))
             except viewer.ViewerUnavailable as exc:
-                raise UserError(f"no screenshot: {_first_line(exc)}; {EGL_HINT}") from None
+                raise UserError(f"no screenshot: {_with_hint(exc)}") from None
             print(f"  wrote {args.screenshot}")
     return 0
 

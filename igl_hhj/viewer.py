@@ -151,7 +151,7 @@ def init(backend="auto"):
     except Exception as exc:
         _reset_after_failed_init(ps)
         hint = (f"; {_EGL_HINT}" if "egl" in backend.lower() else
-                "; without a display, pass screenshot='out.png' to render headless (EGL)" if backend == "auto"
+                f"; there is no display and no usable EGL for headless rendering; {_EGL_HINT}" if backend == "auto"
                 else "")
         raise ViewerUnavailable(f"polyscope could not initialise backend {backend!r}: "
                                 f"{str(exc).replace('[polyscope] ', '')}{hint}") from None

@@ -494,3 +494,20 @@ def test_usage_errors_are_one_line(capsys):
     assert "--robust" in one_error_line(capsys.readouterr().err)
     assert cli.main(["curvature", "--help"]) == 0
     assert "--method" in capsys.readouterr().out
+
+
+def test_demo_without_egl_end_to_end(tmp_path):
+    """A real process whose libEGL cannot be loaded (shadowed by an empty file):
+    the table, one warning line naming the Debian packages, exit 0, no picture,
+    no polyscope chatter and no crash."""
+    for lib in ("libEGL.so", "libEGL.so.1"):
+        (tmp_path / lib).write_bytes(b"")
+    env = dict(os.environ, LD_LIBRARY_PATH=str(tmp_path))
+    out = subprocess.run([sys.executable, "-m", "igl_hhj.cli", "demo", "--levels", "1",
+                          "--screenshot", str(tmp_path / "d.png")],
+                         capture_output=True, text=True, env=env, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert "HHJ err H" in out.stdout
+    err = out.stderr.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("igl-hhj: warning: no screenshot") and "libegl1" in err[0]
+    assert not (tmp_path / "d.png").exists()
