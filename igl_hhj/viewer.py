@@ -296,10 +296,18 @@ def _surface(ps, reg, name, V, F, offset=None):
     s = ps.register_surface_mesh(name, V, F, color=(0.75, 0.75, 0.75))  # grey: no quantity shown
     reg.structures[name] = s
     box = np.stack([V.min(axis=0), V.max(axis=0)])
-    reg.bounds = box if reg.bounds is None else np.stack([np.minimum(reg.bounds[0], box[0]),
-                                                          np.maximum(reg.bounds[1], box[1])])
+    reg.bounds = _union_bounds(reg.bounds, box)
     _REGISTERED[name] = box
     return s
+
+
+def _union_bounds(*boxes):
+    """Bounding box (2, 3) of several (2, 3) boxes (None entries ignored; None if all are)."""
+    boxes = [b for b in boxes if b is not None]
+    if not boxes:
+        return None
+    boxes = np.stack(boxes)
+    return np.stack([boxes[:, 0].min(axis=0), boxes[:, 1].max(axis=0)])
 
 
 def _scalar(reg, sname, qname, values, defined_on, vminmax, cmap, enabled=False):
@@ -346,17 +354,14 @@ def _add_estimate(reg, sname, mesh, est, tag, ranges, cmap, directions, directio
     """Scalar (k1, k2, H, K) and direction quantities of one CurvatureEstimate."""
     where = "faces" if est.location == "face" else "vertices"
     for q in QUANTITIES:
-        _scalar(reg, sname, _qname(q, tag, est), getattr(est, q), where, ranges[q], cmap, enabled=(q == enabled))
+        _scalar(reg, sname, f"{LABELS[q]} ({tag} {where})", getattr(est, q), where, ranges[q], cmap,
+                enabled=(q == enabled))
     if directions and est.d1 is not None:
         scale = direction_scale * local_edge_length(mesh, est.location)[:, None]
         normals = mesh.face_normals if est.location == "face" else mesh.vertex_normals
         for k, lab in (("d1", "PD1"), ("d2", "PD2")):
             _line_field(reg, sname, f"{lab} ({tag} {where})", getattr(est, k) * scale, normals, where,
                         enabled=show_directions)
-
-
-def _qname(q, tag, est):
-    return f"{LABELS[q]} ({tag} {'faces' if est.location == 'face' else 'vertices'})"
 
 
 def _polyscope_for(screenshot):
@@ -500,10 +505,9 @@ def register_comparison(V, F, *, hhj=None, libigl=None, per="face", layout="copy
         if offset is None:
             ext = mesh.V.max(axis=0) - mesh.V.min(axis=0)
             offset = np.array([1.15 * ext[0], 0.0, 0.0])
-        offset = np.asarray(offset, dtype=np.float64).reshape(3)
         sh, si = f"{name} HHJ", f"{name} libigl"
         _surface(ps, reg, sh, mesh.V, mesh.F)
-        _surface(ps, reg, si, mesh.V + offset, mesh.F)
+        _surface(ps, reg, si, mesh.V, mesh.F, np.asarray(offset, dtype=np.float64).reshape(3))
     else:
         sh = si = name
         _surface(ps, reg, name, mesh.V, mesh.F)
@@ -573,6 +577,10 @@ def register_hessian(V, F, w, *, boundary_gradient=None, name="mesh", label="w",
     return _finish(reg, screenshot, size)
 
 
+_BIHARMONIC_LABELS = {"u1": "u1 (approx. u)", "u2": "u2 (approx. -Laplacian u)", "u": "u exact",
+                      "error": "error u1 - u", "f": "f"}
+
+
 def register_biharmonic(V, F, u1, u2=None, *, exact=None, f=None, name="mesh", enabled="u1", symmetric=None,
                         robust=None, ranges=None, offset=None, screenshot=None, size=(1024, 768)):
     """Register a mixed-P1 biharmonic solution (Stein et al.): ``u1 ≈ u``, ``u2 ≈ -Δu``.
@@ -628,9 +636,8 @@ def register_biharmonic(V, F, u1, u2=None, *, exact=None, f=None, name="mesh", e
                            else color_range(*vals, symmetric=sym, robust=robust))
         cm = "coolwarm" if sym else "viridis"
         for k in [key] + (["u"] if key == "u1" and "u" in fields else []):
-            qname = {"u1": "u1 (approx. u)", "u2": "u2 (approx. -Laplacian u)", "u": "u exact",
-                     "error": "error u1 - u", "f": "f"}[k]
-            _scalar(reg, name, qname, fields[k], "vertices", reg.ranges[key], cm, enabled=(k == enabled))
+            _scalar(reg, name, _BIHARMONIC_LABELS[k], fields[k], "vertices", reg.ranges[key], cm,
+                    enabled=(k == enabled))
     return _finish(reg, screenshot, size)
 
 
@@ -738,9 +745,7 @@ def merge(*registrations):
         out.structures.update(r.structures)
         out.quantities.update(r.quantities)
         out.ranges.update(r.ranges)
-        if r.bounds is not None:
-            out.bounds = r.bounds if out.bounds is None else np.stack(
-                [np.minimum(out.bounds[0], r.bounds[0]), np.maximum(out.bounds[1], r.bounds[1])])
+    out.bounds = _union_bounds(*(r.bounds for r in registrations))
     return out
 
 
@@ -848,10 +853,8 @@ def screenshot(path, registration=None, *, size=(1024, 768)):
     if registration is None:
         import polyscope as ps
         names = [n for n in _REGISTERED if ps.has_surface_mesh(n)]
-        registration = Registration(structures={n: None for n in names})
-        if names:
-            boxes = np.stack([_REGISTERED[n] for n in names])
-            registration.bounds = np.stack([boxes[:, 0].min(axis=0), boxes[:, 1].max(axis=0)])
+        registration = Registration(structures={n: None for n in names},
+                                    bounds=_union_bounds(*(_REGISTERED[n] for n in names)))
     elif isinstance(registration, (list, tuple)):
         registration = merge(*registration)
     return _render(registration, path, size)
