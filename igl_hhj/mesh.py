@@ -33,6 +33,22 @@ __all__ = ["TriangleMesh", "validate_mesh", "as_mesh"]
 DEGENERATE_AREA_RTOL = 1e-12
 
 
+def zero_area_faces(edge_vectors, double_areas):
+    """(#F,) bool: the faces igl_hhj rejects as degenerate.
+
+    Parameters
+    ----------
+    edge_vectors : (#F, 3, 3) the three edge vectors of each face
+    double_areas : (#F,) twice the face areas
+
+    A face is degenerate when ``double_area ≤ DEGENERATE_AREA_RTOL × (longest
+    edge)²`` (NaN areas count as degenerate).  The one criterion behind
+    :class:`TriangleMesh`'s check and ``igl-hhj info``'s count.
+    """
+    l2max = (np.asarray(edge_vectors) ** 2).sum(axis=2).max(axis=1)
+    return ~(np.asarray(double_areas) > DEGENERATE_AREA_RTOL * l2max)
+
+
 def _as_array(x, name):
     if isinstance(x, np.ndarray):
         return x
@@ -326,14 +342,14 @@ class TriangleMesh:
 
     # ------------------------------------------------------------ checks
     def _check_degenerate(self):
-        l2max = (self._edge_vectors ** 2).sum(axis=2).max(axis=1)
         dbl = self.face_double_areas
-        bad = ~(dbl > DEGENERATE_AREA_RTOL * l2max)
+        bad = zero_area_faces(self._edge_vectors, dbl)
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
+            longest = np.sqrt((self._edge_vectors[i] ** 2).sum(axis=1).max())
             raise ValueError(
                 f"F has degenerate (zero-area) faces; first at face {i}: {self.F[i]} "
-                f"(area {0.5 * dbl[i]:.3g}, longest edge {np.sqrt(l2max[i]):.3g})")
+                f"(area {0.5 * dbl[i]:.3g}, longest edge {longest:.3g})")
 
     def _check_manifold_and_orientation(self):
         count = self.edge_face_count

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .mesh import DEGENERATE_AREA_RTOL, TriangleMesh
+from .mesh import TriangleMesh, zero_area_faces
 
 __all__ = ["MeshReport", "mesh_report"]
 
@@ -181,9 +181,9 @@ def mesh_report(V, F):
     rep.n_repeated_vertex_faces = int(repeated.sum())
     if np.isfinite(V).all():
         X = V[F].astype(np.float64)
-        l2max = ((X[:, [2, 0, 1]] - X[:, [1, 2, 0]]) ** 2).sum(axis=2).max(axis=1)
         dbl = np.asarray(igl.doublearea(np.ascontiguousarray(V, dtype=np.float64), F)).ravel()
-        rep.n_zero_area_faces = int((~(dbl > DEGENERATE_AREA_RTOL * l2max) & ~repeated).sum())
+        zero = zero_area_faces(X[:, [2, 0, 1]] - X[:, [1, 2, 0]], dbl)
+        rep.n_zero_area_faces = int((zero & ~repeated).sum())
         rep.mean_edge_length = float(np.linalg.norm(V[uE[:, 1]] - V[uE[:, 0]], axis=1).mean())
     rep.n_duplicate_faces = int(nF - len(igl.unique_simplices(F)[0]))
 
