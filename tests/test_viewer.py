@@ -226,6 +226,34 @@ def test_bad_input(mock, ellipsoid, tmp_path):
     Fb[0, 0] = -1
     with pytest.raises(ValueError, match="negative vertex indices"):
         viewer.register_comparison(V, Fb)
+    with pytest.raises(ValueError, match=r"size must be \(width, height\)"):
+        viewer.register_curvature(V, F, screenshot=tmp_path / "x.png", size=800)
+    with pytest.raises(ValueError, match=r"a colour range must be \(lo, hi\), got"):
+        viewer.register_scalars(V, F, {"x": V[:, 0]}, vminmax="wide")
+    with pytest.raises(ValueError, match=r"u1 must have shape"):
+        viewer.register_biharmonic(V, F, np.ones(4))
+    with pytest.raises(ValueError, match="enabled must be one of"):
+        viewer.register_biharmonic(V, F, V[:, 0], enabled="error")      # no exact solution given
+    with pytest.raises(ValueError, match="enabled must be one of"):
+        viewer.register_regge_curvature(V, F, compare=False, enabled="hhj")
+    with pytest.raises(ValueError, match="enabled must be one of"):
+        viewer.register_hessian(V, F, V[:, 0], enabled="det")
+
+
+def test_screenshot_path_not_writable(mock, ellipsoid, tmp_path, monkeypatch):
+    # permissions cannot be tested as root (root writes anywhere): fake the access check
+    monkeypatch.setattr(viewer.os, "access", lambda path, mode: False)
+    with pytest.raises(ValueError, match="is not writable"):
+        viewer.register_curvature(*ellipsoid, screenshot=tmp_path / "x.png")
+
+
+def test_render_refuses_removed_structures(egl, sphere, tmp_path):
+    V, F = sphere
+    reg = viewer.register_scalars(V, F, {"x": V[:, 0]}, name="gone")
+    ps.remove_surface_mesh("gone")
+    with pytest.raises(ValueError, match="no longer registered"):
+        viewer.screenshot(tmp_path / "g.png", reg)
+    assert not (tmp_path / "g.png").exists()
 
 
 # --------------------------------------------------------------------------- headless renders (EGL)
