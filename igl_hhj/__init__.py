@@ -28,6 +28,7 @@ from .curvature import (
     shape_operator,
     surface_hessian,
 )
+from .errors import SolverDidNotConverge, SolverError
 from .mesh import TriangleMesh, validate_mesh
 
 __version__ = "0.1.0"
@@ -40,7 +41,7 @@ __all__ = [
     "shape_operator", "surface_hessian", "principal_curvature",
     "face_principal_curvature", "face_mean_curvature", "face_gaussian_curvature",
     "principal_from_shape_operator", "TriangleMesh", "validate_mesh",
-    "biharmonic_solve", "BiharmonicSolver",
+    "biharmonic_solve", "BiharmonicSolver", "SolverError", "SolverDidNotConverge",
 ]
 
 

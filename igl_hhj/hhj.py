@@ -28,6 +28,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from .errors import SolverDidNotConverge
 from .mesh import TriangleMesh
 
 __all__ = [
@@ -42,10 +43,6 @@ AUTO_DIRECT_MAX = 50000
 # ... and gives PCG this many iterations before falling back to the direct solver
 # (well-shaped meshes need 50–250; meshes full of slivers can need thousands).
 AUTO_CG_MAXITER = 600
-
-
-class SolverDidNotConverge(RuntimeError):
-    """Raised when the preconditioned CG solve does not reach its tolerance."""
 
 
 def _sym_outer(u, v):
