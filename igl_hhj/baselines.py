@@ -25,7 +25,7 @@ Estimators
     ``K = M⁻¹ (2π - Σθ)`` (``igl.gaussian_curvature``, angle defect);
     ``κ1,2 = H ± sqrt(max(H² - K, 0))`` (Meyer et al. 2003).  No directions.
 ``heine``
-    Heine's discrete Weingarten map for P1 Lagrange elements (paper 003,
+    Heine's discrete Weingarten map for P1 Lagrange elements (Heine 2006,
     Def. 3.1 and 3.2).  **Does not converge** for degree 1 (Heine, Tables
     5.1–5.4, and our tests): it is here as the finite-element baseline HHJ
     improves on.
@@ -314,7 +314,7 @@ def _mass_solve(mesh, M, R):
 
 
 def heine_curvature_vector(V, F, _M=None):
-    """Heine's discrete curvature vector Y_h (paper 003, Def. 3.1, eq. 3.1), P1 elements.
+    """Heine's discrete curvature vector Y_h (Heine 2006, Def. 3.1, eq. 3.1), P1 elements.
 
     ``(Y_h, ψ_h) = (∇_Γh id, ∇_Γh ψ_h)`` for all P1 ψ_h, i.e. ``M Y = -L X``
     with the **consistent** P1 mass matrix M (``igl.massmatrix`` FULL) and
@@ -331,7 +331,7 @@ def heine_curvature_vector(V, F, _M=None):
 
 
 def heine_weingarten_map(V, F):
-    """Heine's discrete Weingarten map Π_h for P1 elements (paper 003, Def. 3.2).
+    """Heine's discrete Weingarten map Π_h for P1 elements (Heine 2006, Def. 3.2).
 
     Solves, for j = 1..3 and all P1 vector test functions ψ_h,
 

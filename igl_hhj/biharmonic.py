@@ -2,10 +2,10 @@
 
 Source: O. Stein, E. Grinspun, A. Jacobson, M. Wardetzky, *A mixed finite
 element method with piecewise linear elements for the biharmonic equation on
-surfaces* (paper 001), eq. (1.3), (1.5), §5.3 and §6 (eq. 6.1–6.5).
+surfaces* (Stein et al. 2022), eq. (1.3), (1.5), §5.3 and §6 (eq. 6.1–6.5).
 
 We solve ``Δ²u = f`` on a triangle mesh Γ_h with two P1 unknowns,
-``u1 ≈ u`` and ``u2 ≈ -Δu`` (the sign of paper 001: ``(∇u1, ∇η) = (u2, η)``),
+``u1 ≈ u`` and ``u2 ≈ -Δu`` (the sign of Stein et al. 2022: ``(∇u1, ∇η) = (u2, η)``),
 
     (∇u2, ∇ξ) = (f, ξ)              for all ξ ∈ S_h,0,
     (∇u1, ∇η) = (u2, η) + ∫_∂ q η   for all η ∈ S_h         (eq. 1.5)
@@ -24,12 +24,12 @@ matrix is the *negative* semi-definite one), ``M`` the P1 mass matrix (eq. 6.4),
 Boundary conditions (``bc``)
 ----------------------------
 ``"clamped"``
-    ``u = g``, ``∂u/∂n = q`` (paper 001's case, ``g = q = 0`` by default):
+    ``u = g``, ``∂u/∂n = q`` (Stein et al.'s case, ``g = q = 0`` by default):
     ``u1`` in S_h,0 (+ g), ``u2`` free: the saddle system above.
 ``"navier"``
     ``u = g``, ``-Δu = w`` (simply supported; ``g = w = 0`` by default): both
     unknowns in S_h,0 (+ data); the system decouples into two Dirichlet
-    Poisson problems with the same matrix ``K_II`` (paper 001, §5.3, remark).
+    Poisson problems with the same matrix ``K_II`` (Stein et al. 2022, §5.3, remark).
 ``"closed"``
     no boundary (§5.3): ``u1``, ``u2`` have zero mean on every connected
     component, and ``f`` must have zero mean, ``∫_Γh I_h f = 0`` (checked, or
@@ -98,7 +98,7 @@ ZERO_MEAN_RTOL = 1e-10
 
 # ---------------------------------------------------------------- matrices
 def stiffness_matrix(mesh):
-    """P1 stiffness matrix ``K_ij = ∫ ∇φ_i · ∇φ_j`` (paper 001, eq. 6.3).
+    """P1 stiffness matrix ``K_ij = ∫ ∇φ_i · ∇φ_j`` (Stein et al. 2022, eq. 6.3).
 
     ``K = -igl.cotmatrix(V, F)``: libigl's cotangent matrix is negative
     semi-definite, ``K`` is positive semi-definite.
@@ -277,7 +277,7 @@ class BiharmonicSolver:
 
     References
     ----------
-    Stein, Grinspun, Jacobson, Wardetzky (paper 001), eq. (1.5), (6.1)–(6.5).
+    Stein, Grinspun, Jacobson, Wardetzky (2022), eq. (1.5), (6.1)–(6.5).
     """
 
     def __init__(self, V, F=None, *, bc="clamped", mass="full", solver="auto", rtol=1e-10):
@@ -550,7 +550,7 @@ class BiharmonicSolver:
 
 def biharmonic_solve(V, F, f, *, bc="clamped", mass="full", g=None, q=None, w=None,
                      project_mean=False, solver="auto", rtol=1e-10):
-    """Solve ``Δ²u = f`` on a triangle mesh with the mixed P1 method (paper 001).
+    """Solve ``Δ²u = f`` on a triangle mesh with the mixed P1 method (Stein et al. 2022).
 
     One-shot wrapper around :class:`BiharmonicSolver`; use the class to reuse
     the factorisation for several right-hand sides.
@@ -562,7 +562,7 @@ def biharmonic_solve(V, F, f, *, bc="clamped", mass="full", g=None, q=None, w=No
     f : (#V,) array_like, scalar, or callable ``f(X: (#V, 3)) -> (#V,)``
         Right-hand side sampled at the vertices; load ``∫ φ_i I_h f`` (eq. 6.5).
     bc : {"clamped", "navier", "closed"}
-        ``u = ∂u/∂n = 0`` (paper 001), ``u = Δu = 0``, or no boundary with
+        ``u = ∂u/∂n = 0`` (Stein et al. 2022), ``u = Δu = 0``, or no boundary with
         zero-mean ``u1``, ``u2`` (§5.3).
     mass : {"full", "lumped", "voronoi"}
         Consistent mass (the paper) or lumped (geometry-processing ``K M⁻¹ K``).
@@ -578,7 +578,7 @@ def biharmonic_solve(V, F, f, *, bc="clamped", mass="full", g=None, q=None, w=No
     u1 : (#V,) float64
         ≈ u at the vertices.
     u2 : (#V,) float64
-        ≈ -Δu at the vertices (the sign of paper 001).
+        ≈ -Δu at the vertices (the sign of Stein et al. 2022).
 
     Examples
     --------

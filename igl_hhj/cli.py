@@ -108,6 +108,11 @@ def _check_writable(path, extensions=None):
         raise UserError(str(exc)) from None
 
 
+def _say(args):
+    """``print`` for the summary lines, or a no-op with ``-q``."""
+    return (lambda *a, **k: None) if getattr(args, "quiet", False) else print
+
+
 def _viewer():
     from . import viewer
     return viewer
@@ -199,6 +204,8 @@ def _curvature(args):
     from . import baselines
     from .mesh import TriangleMesh
 
+    say = _say(args)
+
     per = args.per
     if args.method != "hhj" and per == "face":
         raise UserError(f"--method {args.method} computes per-vertex curvature only; "
@@ -236,17 +243,17 @@ def _curvature(args):
                          baselines.estimate, ESTIMATORS[args.method, per], mesh.V, mesh.F)
     dt = time.perf_counter() - t
 
-    print(f"{args.mesh}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, "
+    say(f"{args.mesh}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, "
           f"{int(mesh.boundary_edges.sum())} boundary edges")
-    print(f"  method {args.method} per {per}: {dt:.2f} s")
+    say(f"  method {args.method} per {per}: {dt:.2f} s")
     for name, x in [("k1", est.k1), ("k2", est.k2), ("H", est.H), ("K", est.K)]:
         q = np.nanpercentile(x, [1, 50, 99]) if np.isfinite(x).any() else [np.nan] * 3
-        print(f"  {name:>3}: 1% {q[0]: .4g}   median {q[1]: .4g}   99% {q[2]: .4g}")
+        say(f"  {name:>3}: 1% {q[0]: .4g}   median {q[1]: .4g}   99% {q[2]: .4g}")
     n_nan = int(np.isnan(est.k1).sum())
     if n_nan:
         why = {"hhj": "unreferenced vertices", "heine": "unreferenced vertices",
                "igl": "unreferenced vertices and those libigl flags as bad (< 6 neighbours)"}
-        print(f"  {n_nan} {'vertice' if per == 'vertex' else 'face'}s have no value (NaN): "
+        say(f"  {n_nan} {'vertice' if per == 'vertex' else 'face'}s have no value (NaN): "
               f"{why[args.method]}")
 
     if args.out is not None:
@@ -269,7 +276,7 @@ def _curvature(args):
                            estimate=est, name=name, robust=robust, screenshot=str(args.screenshot))
             except viewer.ViewerUnavailable as exc:
                 raise UserError(f"no screenshot: {_with_hint(exc)}") from None
-            print(f"  wrote {args.screenshot}")
+            say(f"  wrote {args.screenshot}")
     return 0
 
 
@@ -280,7 +287,7 @@ def _write(stages, args, mesh, est, S):
                    method=args.method, S=S)
     except OSError as exc:
         raise UserError(f"{args.out}: cannot write: {exc.strerror or exc}") from None
-    print(f"  wrote {args.out}")
+    _say(args)(f"  wrote {args.out}")
 
 
 # --------------------------------------------------------------------------- info
@@ -295,15 +302,44 @@ def _info(args):
 
 
 # --------------------------------------------------------------------------- main
+def _version():
+    from importlib import metadata
+
+    from . import __version__
+    try:
+        libigl = metadata.version("libigl")
+    except metadata.PackageNotFoundError:  # pragma: no cover - libigl is a dependency
+        libigl = "not installed"
+    return f"igl-hhj {__version__} (libigl {libigl})"
+
+
+def _named_demo(argv):
+    """``igl-hhj demo NAME [options]``: run demo NAME of :mod:`igl_hhj.demos` with its own
+    options; None when ``argv`` is not such a call."""
+    from .demos import DEMOS, run
+    if argv is None:
+        argv = sys.argv[1:]
+    if len(argv) >= 2 and argv[0] == "demo" and argv[1] in DEMOS:
+        return run(argv[1], argv[2:], prog=f"igl-hhj demo {argv[1]}")
+    return None
+
+
 def build_parser():
     parser = _Parser(prog="igl-hhj",
                      description="igl_hhj: convergent finite-element (HHJ) curvature of triangle meshes.",
                      epilog="exit codes: 0 ok, 1 info: mesh rejected, 2 user error")
+    parser.add_argument("--version", action="version", version=_version(),
+                        help="print the versions of igl-hhj and libigl and exit")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
-    d = sub.add_parser("demo", help="HHJ vs libigl curvature on a built-in ellipsoid mesh sequence",
-                       description="Error table of HHJ and libigl curvature against the exact ellipsoid, "
-                                   "then a screenshot of the finest mesh.")
+    from .demos import DEMOS
+    d = sub.add_parser("demo", help="HHJ vs libigl curvature on a built-in ellipsoid mesh sequence; "
+                                    "'demo NAME' runs one of the demos",
+                       description="Without NAME: error table of HHJ and libigl curvature against the "
+                                   "exact ellipsoid, then a screenshot of the finest mesh. With NAME: "
+                                   "run that demo with its own options (see 'igl-hhj demo NAME --help').")
+    d.add_argument("name", nargs="?", choices=DEMOS, metavar="NAME",
+                   help=f"one of {', '.join(DEMOS)} (its options follow the name)")
     d.add_argument("--levels", type=int, default=4, help="number of refinement levels (default 4)")
     d.add_argument("--seed", type=int, default=0, help="seed of the coarse-mesh jitter (default 0)")
     d.add_argument("--screenshot", default="igl_hhj_demo.png", metavar="PNG",
@@ -323,15 +359,17 @@ def build_parser():
                    help="vertex (default, comparable with libigl) or face (HHJ's native "
                         "piecewise-constant values; hhj only)")
     c.add_argument("-o", "--out", metavar="OUT",
-                   help="write k1, k2, H, K, d1, d2 to OUT.npz (+ V, F, and the shape operator S "
-                        "for hhj), OUT.csv or OUT.ply (binary, values as vertex or face properties)")
+                   help="output file, by extension: OUT.npz (k1, k2, H, K, d1, d2, V, F, and the "
+                        "shape operator S for hhj), OUT.csv (one row per vertex or face), OUT.ply "
+                        "(binary, the values as vertex or face properties)")
     c.add_argument("--view", action="store_true", help="open the polyscope viewer")
     c.add_argument("--screenshot", metavar="PNG", help="render the curvature headless to PNG")
     c.add_argument("--robust", type=float, default=1.0, metavar="P",
                    help="colour range of --view/--screenshot from the P-th to the (100-P)-th "
                         "percentile (default 1; 0: full range)")
     c.add_argument("-q", "--quiet", action="store_true",
-                   help=f"no progress lines (printed on stderr for meshes > {LARGE_MESH_FACES} faces)")
+                   help=f"print nothing but warnings and errors: no summary on stdout, no progress "
+                        f"lines (stderr, meshes > {LARGE_MESH_FACES} faces)")
     c.set_defaults(func=_curvature)
 
     i = sub.add_parser("info", help="mesh statistics and whether igl_hhj accepts the mesh",
@@ -347,6 +385,9 @@ def build_parser():
 def main(argv=None):
     """Run the command line; returns the exit code (``sys.exit(main())``)."""
     try:
+        named = _named_demo(argv)
+        if named is not None:
+            return named
         args = build_parser().parse_args(argv)
         return args.func(args)
     except UserError as exc:

@@ -1,6 +1,6 @@
 """Error norms and experimental orders of convergence (EOC) against exact surfaces.
 
-Errors follow Walker §6 (paper 000): the exact fields are interpolated at the
+Errors follow Walker §6 (Walker 2023): the exact fields are interpolated at the
 vertices (``I_h``, P1) and compared with the discrete, piecewise-constant
 fields on the flat triangles.  The integrals of squared differences are exact
 (3-point edge-midpoint rule, exact for quadratics).

@@ -2,7 +2,7 @@
 unique edge, over libigl's mesh topology.
 
 Source: S. W. Walker, *Approximating the shape operator with the surface HHJ
-element* (paper 000), §3–§5, made concrete in ``shared/design/hhj_lowest_order.md``.
+element* (Walker 2023), §3–§5, made concrete in ``shared/design/hhj_lowest_order.md``.
 
 The space ``V_h`` holds piecewise-constant symmetric tangential 3×3 tensors whose
 normal–normal component ``nᵀσn`` is single valued across every edge (each face

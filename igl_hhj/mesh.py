@@ -13,7 +13,7 @@ Conventions (libigl's, restated because every formula depends on them)
   normal of ``(x1 - x0) × (x2 - x0)``; ``n_i = t_i × ν_T`` is the unit
   *outward* conormal of edge ``i`` in the plane of ``T``;
   ``∇λ_i = -l_i n_i / (2|T|)`` is the gradient of the P1 hat function of
-  corner ``i`` on ``T`` (Walker, paper 000, §4; design note hhj_lowest_order).
+  corner ``i`` on ``T`` (Walker 2023, §4; design note hhj_lowest_order).
 
 Input checks raise ``TypeError`` (wrong kind of array) or ``ValueError`` (bad
 values), each naming the problem and the first offending index.  Unreferenced

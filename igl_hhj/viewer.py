@@ -108,6 +108,12 @@ class Registration:
         """Quantity names registered on ``structure``."""
         return [q for s, q in self.quantities if s == structure]
 
+    def __repr__(self):
+        shown = [f"{s}: {q}" for (s, q), info in self.quantities.items() if info.enabled]
+        return (f"Registration(structures={list(self.structures)}, {len(self.quantities)} quantities, "
+                f"shown={shown}, ranges={ {k: tuple(round(x, 6) for x in v) for k, v in self.ranges.items()} }"
+                + (f", screenshot={self.screenshot!r}" if self.screenshot else "") + ")")
+
 
 # --------------------------------------------------------------------------- backend
 def _backend_name(ps):
@@ -146,6 +152,8 @@ def init(backend="auto"):
     # "auto" without a display falls back to headless EGL: registering and
     # screenshots work everywhere, show() says that there is no window.
     ps.set_allow_headless_backends(True)
+    # no .polyscope.ini / imgui.ini in the user's current folder
+    ps.set_use_prefs_file(False)
     try:
         ps.init(backend)
     except Exception as exc:
@@ -644,7 +652,7 @@ def register_biharmonic(V, F, u1, u2=None, *, exact=None, f=None, name="mesh", e
 def register_regge_curvature(V, F, *, boundary="natural", mass="consistent", compare=True, name="mesh",
                              enabled="K_h", symmetric=True, robust=None, cmap="coolwarm", vminmax=None,
                              offset=None, screenshot=None, size=(1024, 768)):
-    """Register the Regge (degree-0, edge-length metric) Gauss curvature K_h (paper 004).
+    """Register the Regge (degree-0, edge-length metric) Gauss curvature K_h (Gopalakrishnan et al. 2024).
 
     Parameters
     ----------

@@ -511,3 +511,49 @@ def test_demo_without_egl_end_to_end(tmp_path):
     err = out.stderr.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("igl-hhj: warning: no screenshot") and "libegl1" in err[0]
     assert not (tmp_path / "d.png").exists()
+
+
+# --------------------------------------------------------------------------- packaging hygiene (issue 14)
+def test_version(capsys):
+    import igl_hhj
+    assert cli.main(["--version"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f"igl-hhj {igl_hhj.__version__} ") and "libigl 2.6" in out
+
+
+def test_quiet_silences_the_summary(sphere, tmp_path, capsys):
+    path, _, _ = sphere
+    out = tmp_path / "k.npz"
+    assert cli.main(["curvature", str(path), "-o", str(out)]) == 0
+    assert "wrote" in capsys.readouterr().out
+    out.unlink()
+    assert cli.main(["curvature", str(path), "-o", str(out), "-q"]) == 0
+    cap = capsys.readouterr()
+    assert cap.out == "" and cap.err == "" and out.exists()
+
+
+def test_named_demo_help_and_bad_name(capsys):
+    from igl_hhj.demos import DEMOS
+    for name in DEMOS:
+        assert cli.main(["demo", name, "--help"]) == 0
+        out = capsys.readouterr().out
+        assert out.startswith(f"usage: igl-hhj demo {name}") and "What you see" in out
+    assert cli.main(["demo", "nosuch"]) == 2
+    assert "invalid choice" in one_error_line(capsys.readouterr().err)
+    assert cli.main(["demo", "regge", "--levels", "1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("igl-hhj demo regge: error: --levels")
+
+
+@pytest.mark.parametrize("argv", [["demo", "--levels", "1"],
+                                  ["demo", "regge", "--levels", "2", "--screenshot", "r.png", "--size", "64", "64"]])
+def test_demos_leave_no_files_and_no_egl_chatter(tmp_path, argv):
+    """igl-hhj demo [NAME] in a fresh folder: only the picture it announces, no
+    imgui.ini / .polyscope.ini, and none of polyscope's '[polyscope] EGL ...' lines."""
+    from conftest import require_egl
+    require_egl()
+    res = subprocess.run([sys.executable, "-m", "igl_hhj.cli", *argv], cwd=tmp_path, capture_output=True,
+                         text=True, timeout=300)
+    assert res.returncode == 0, res.stderr[-2000:]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [("r.png" if "regge" in argv else "igl_hhj_demo.png")]
+    assert "[polyscope]" not in res.stdout + res.stderr, res.stdout + res.stderr

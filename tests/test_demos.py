@@ -159,7 +159,7 @@ def test_biharmonic(tmp_path, requires_egl, bc):
     errs = [number(r[3]) for r in body]
     assert all(np.isfinite(errs)) and errs[-1] < errs[0]
     assert number(body[-1][4]) > 1.5, out        # u1 converges at about O(h²) on these sequences
-    assert "paper 001" in out
+    assert "Stein et al. 2022" in out
 
 
 def test_regge(tmp_path, requires_egl):

@@ -20,3 +20,22 @@ def test_lazy_attributes():
         assert "no_such_thing" in str(exc)
     else:
         raise AssertionError("missing attribute did not raise")
+
+
+def test_benchmark_progress_bars_stay_out_of_redirected_logs():
+    """tqdm draws only on a terminal (disable=None): a log file gets no bar frames."""
+    code = "from igl_hhj.benchmarks import progress\nfor _ in progress(range(50), 'x', 'it'): pass\n"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stderr == "" and out.stdout == ""
+
+
+def test_extras_and_license():
+    """A `demos` extra with what the demos import, an `all` extra, and the MPL-2.0 text."""
+    import tomllib
+    from pathlib import Path
+    root = Path(__file__).resolve().parents[1]
+    extras = tomllib.loads((root / "pyproject.toml").read_text())["project"]["optional-dependencies"]
+    names = {e: {r.split(">")[0].split("[")[0].split("=")[0].strip() for r in reqs} for e, reqs in extras.items()}
+    assert {"matplotlib", "triangle", "gpytoolbox"} <= names["demos"]
+    assert any("demos" in r and "benchmark" in r for r in extras["all"])
+    assert (root / "LICENSE").read_text().startswith("Mozilla Public License Version 2.0")

@@ -335,3 +335,10 @@ def test_missing_egl_is_a_clear_error_not_a_crash(tmp_path):
     assert out.stdout.count("UNAVAILABLE") == 2 and "libegl1 libegl-mesa0 libgl1-mesa-dri" in out.stdout
     assert "STILL USABLE" in out.stdout and "Exception ignored" not in out.stderr
     assert not (tmp_path / "x.png").exists()
+
+
+def test_registration_repr_is_short(mock, ellipsoid):
+    reg = viewer.register_comparison(*ellipsoid, name="r")
+    text = repr(reg)
+    assert len(text) < 400 and "array" not in text
+    assert "'r HHJ'" in text and "mean H (HHJ faces)" in text

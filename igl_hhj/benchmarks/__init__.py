@@ -10,4 +10,4 @@ def progress(iterable, desc, unit, enabled=True):
         from tqdm import tqdm
     except ImportError:  # pragma: no cover - tqdm is in the benchmark extra
         return iterable
-    return tqdm(iterable, desc=desc, unit=unit)
+    return tqdm(iterable, desc=desc, unit=unit, disable=None)  # no bar frames in redirected logs

@@ -119,7 +119,7 @@ def _fmt_table(name, rows):
         lines.append("| " + " | ".join(cells) + " |")
     p = PAPER[name]
     lines += ["", f"exact area: {EXACT_AREA[name]:.4f}; "
-                  f"paper 001 proven rates: u1 L2 {p['u1_L2']}, u1 H1 {p['u1_H1']}, u2 L2 {p['u2_L2']}; "
+                  f"Stein et al. 2022 proven rates: u1 L2 {p['u1_L2']}, u1 H1 {p['u1_H1']}, u2 L2 {p['u2_L2']}; "
                   f"observed: {p['observed']}"]
     return "\n".join(lines)
 
@@ -323,14 +323,16 @@ def run(levels=5, seed=0, out="benchmark-results", perf=False, perf_max_vertices
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--levels", type=int, default=5)
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--out", default="benchmark-results")
+    ap.add_argument("--levels", type=int, default=5, help="refinement levels per case (default 5)")
+    ap.add_argument("--seed", type=int, default=0, help="seed of the mesh jitter (default 0)")
+    ap.add_argument("--out", default="benchmark-results",
+                    help="folder for the tables and plots (default ./benchmark-results/)")
     ap.add_argument("--perf", action="store_true", help="also run the timing study")
     ap.add_argument("--perf-only", action="store_true", help="only the timing study")
-    ap.add_argument("--perf-max-vertices", type=int, default=600_000)
-    ap.add_argument("--perf-rings", type=int, default=7)
-    ap.add_argument("--no-plot", action="store_true")
+    ap.add_argument("--perf-max-vertices", type=int, default=600_000,
+                    help="largest mesh of the timing study, in vertices (default 600000)")
+    ap.add_argument("--perf-rings", type=int, default=7, help="rings of the coarse hemisphere mesh of the timing study (default 7)")
+    ap.add_argument("--no-plot", action="store_true", help="no matplotlib plots")
     a = ap.parse_args(argv)
     run(levels=a.levels, seed=a.seed, out=a.out, perf=a.perf or a.perf_only,
         perf_max_vertices=a.perf_max_vertices, perf_rings=a.perf_rings, plot=not a.no_plot,

@@ -40,7 +40,7 @@ from ..baselines import ESTIMATORS
 from ..mesh import as_mesh
 
 # --------------------------------------------------------------------------- paper data
-#: Heine (paper 003), Tables 5.1 and 5.3, polynomial degree 1: relative errors
+#: Heine (2006), Tables 5.1 and 5.3, polynomial degree 1: relative errors
 #: of the mean curvature H (L2) and Gauss curvature K (L2) on the finest meshes
 #: of (5.1a) and (5.1c), copied from the paper.  EOC ≈ 0 (no convergence).
 HEINE_PAPER_P1 = {
@@ -590,7 +590,7 @@ def run(out="benchmark-results", quick=False, real=None, do_speed=True, screensh
     n_acc = sum(len(c[2]) for c in cases.values()) * len(estimators)
     n_speed = len(speed_sizes) * len(estimators) if do_speed else 0
     n_real = (len(list(Path(mesh_folder).glob("*.off"))) * len(estimators)) if (real and mesh_folder) else 0
-    with tqdm(total=n_acc + n_speed + n_real, desc="compare_estimators", unit="run") as bar:
+    with tqdm(total=n_acc + n_speed + n_real, desc="compare_estimators", unit="run", disable=None) as bar:
         acc = accuracy(cases, estimators, bar)
         spd = speed(speed_sizes, estimators, bar) if do_speed else []
         rl = real_meshes(mesh_folder, estimators, outdir, screenshots, bar) if n_real else []
@@ -611,11 +611,12 @@ def run(out="benchmark-results", quick=False, real=None, do_speed=True, screensh
 
 def main(argv=None):
     p = argparse.ArgumentParser(description="Compare HHJ curvature with libigl, Heine and pymeshlab.")
-    p.add_argument("--out", default="benchmark-results")
+    p.add_argument("--out", default="benchmark-results",
+                   help="folder for the tables, plots and screenshots (default ./benchmark-results/)")
     p.add_argument("--quick", action="store_true", help="small meshes, few cases (seconds)")
     p.add_argument("--no-real", action="store_true", help="skip the real meshes and screenshots")
     p.add_argument("--no-speed", action="store_true", help="skip the speed section")
-    p.add_argument("--no-screenshots", action="store_true")
+    p.add_argument("--no-screenshots", action="store_true", help="skip the polyscope screenshots")
     p.add_argument("--estimators", nargs="+", help=f"subset of {sorted(ESTIMATORS)}")
     a = p.parse_args(argv)
     try:

@@ -1,6 +1,6 @@
 """Regge metric layer: distributional Gauss curvature of Regge metrics and its
 lifting to Lagrange elements (Gopalakrishnan–Neunteufel–Schöberl–Wardetzky,
-paper 004: Definitions 2.1 and 2.3, canonical interpolant eq. 3.1, §4).
+Gopalakrishnan et al. 2024: Definitions 2.1 and 2.3, canonical interpolant eq. 3.1, §4).
 
 Degree 0 on triangle meshes (embedded or intrinsic)::
 

@@ -1,5 +1,5 @@
 """Distributional densitized Gauss curvature of a Regge metric and its lifting
-to Lagrange elements (paper 004, Definition 2.1, Definition 2.3, Remark 3.3).
+to Lagrange elements (Gopalakrishnan et al. 2024, Definition 2.1, Definition 2.3, Remark 3.3).
 
 Sign conventions (design note ``regge.md``; the round sphere has ``K = +1``):
 
@@ -254,7 +254,7 @@ class LiftedCurvature:
 
     def h_minus1_error(self, exact, degree=None, quad_degree=None):
         """``‖K̄ - K_h‖_{H⁻¹} ≈ ‖w‖_{H¹}`` (full norm), ``w ∈ V_h^{p+2}`` (default) solving
-        ``-Δw = K̄ - K_h``, ``w = 0`` on ``∂Ω`` (paper 004, §4)."""
+        ``-Δw = K̄ - K_h``, ``w = 0`` on ``∂Ω`` (Gopalakrishnan et al. 2024, §4)."""
         import scipy.sparse.linalg as spla
         tri = self.space.tri
         P = self.degree + 2 if degree is None else _check_int(degree, "degree", 1)
@@ -299,7 +299,7 @@ def gauss_curvature_functional(gh, degree=None, quad_degree=None):
 def lift_gauss_curvature(g_h, degree=None, *, dirichlet=None, dirichlet_values=None,
                          neumann_metric="auto", neumann_curvature=None, densitized=False,
                          quad_degree=None):
-    """Lifted distributional Gauss curvature ``K_h ∈ V_h^p`` (paper 004, Definition 2.3).
+    """Lifted distributional Gauss curvature ``K_h ∈ V_h^p`` (Gopalakrishnan et al. 2024, Definition 2.3).
 
     Find ``K_h`` with ``K_h = I_D K̄`` on ``Γ_D`` and, for all ``u`` vanishing on ``Γ_D``,
 

@@ -5,7 +5,7 @@ The lowest-order Regge space ``Reg_h^0`` is spanned by one DOF per edge,
 (edge lengths and connectivity, no coordinates) — *is* a degree-0 Regge
 metric.  The metric is constant on each triangle, so the element Gauss
 curvature and the geodesic curvature of the (straight, hence geodesic) edges
-vanish, and the distributional densitized Gauss curvature (paper 004,
+vanish, and the distributional densitized Gauss curvature (Gopalakrishnan et al. 2024,
 eq. 2.5) reduces to the angle deficits ``Θ_V = 2π - Σ_T θ_V^T``.  Its P1 lifting
 (Definition 2.3 with ``k = 0``, lifting degree 1) solves ``M K_h = Θ``.
 
@@ -183,7 +183,7 @@ def _lift(Lf, F, nV, uE, count, boundary, mass):
 
 def gauss_curvature_intrinsic(l_sq, F, *, boundary="natural", mass="consistent"):
     """P1 lifting ``K_h`` of the distributional Gauss curvature of the degree-0
-    Regge metric given by squared edge lengths (paper 004, Def. 2.1/2.3, k = 0).
+    Regge metric given by squared edge lengths (Gopalakrishnan et al. 2024, Def. 2.1/2.3, k = 0).
 
     Solves ``M K_h = Θ`` with ``M`` the P1 mass matrix of the metric and ``Θ`` the
     angle deficits (boundary convention ``boundary``, see module docstring).

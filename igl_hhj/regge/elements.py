@@ -6,7 +6,7 @@ triangle ``T̂ = {ξ, η ≥ 0, ξ + η ≤ 1}`` with corners ``v̂_0 = (0, 0)``
 ``(1 - ξ - η, ξ, η)``.  Local edge ``i`` is opposite corner ``i`` and runs from
 corner ``i+1`` to corner ``i+2`` (libigl's order, as in :mod:`igl_hhj.mesh`).
 
-Regge space (paper 004, eq. 2.3).  A Regge function is stored element by
+Regge space (Gopalakrishnan et al. 2024, eq. 2.3).  A Regge function is stored element by
 element through its *pull-back* ``ĝ = J_Tᵀ g J_T`` to ``T̂``: ``ĝ_ij ∈ P^k(T̂)``
 iff ``g_ij ∈ P^k(T)``, and all curvature quantities (Gauss curvature, geodesic
 curvature of edges, angles, volume forms) are coordinate invariant, so they
@@ -465,7 +465,7 @@ class ReggeMetric:
 
 
 def interpolate(P, F, metric, k, quad_degree=None):
-    """Canonical Regge interpolant ``g_h = T_h^{Reg,k} ḡ`` (paper 004, eq. 3.1).
+    """Canonical Regge interpolant ``g_h = T_h^{Reg,k} ḡ`` (Gopalakrishnan et al. 2024, eq. 3.1).
 
     Solves, element by element, the moment equations
 

@@ -1,6 +1,6 @@
 """Exact metrics and meshes for the Regge layer's tests and benchmark.
 
-The §4 example of paper 004 (after Gawlik): the metric of the graph of
+The §4 example of Gopalakrishnan et al. 2024 (after Gawlik): the metric of the graph of
 ``f(x, y) = (x² + y²)/2 - (x⁴ + y⁴)/12`` on the quarter domain ``(0, 1)²``,
 right and bottom sides Dirichlet, left and top Neumann.  Mesh recipe and
 random perturbation exactly as in the design note ``regge.md`` (seed 0).

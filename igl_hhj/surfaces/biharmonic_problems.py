@@ -1,6 +1,6 @@
 """Exact biharmonic test problems ``Δ²u = f`` on surfaces, with mesh generators.
 
-The problems of paper 001 (Stein, Grinspun, Jacobson, Wardetzky), §6, plus the
+The problems of Stein, Grinspun, Jacobson and Wardetzky (2022), §6, plus the
 closed case of §5.3 and flat-plate / inhomogeneous checks.  Every problem gives,
 at points near its surface (mapped to the surface by :meth:`closest_point`),
 
@@ -102,7 +102,7 @@ def cap_mesh(theta0=np.pi / 2, levels=0, rings=3, amount=0.25, seed=0):
     The coarse mesh is a jittered Delaunay disk mapped by ``θ = θ0 ρ`` (azimuthal
     equidistant chart), vertices on the sphere; refinement projects new
     interior vertices radially onto the sphere and new boundary vertices onto
-    the circle ``θ = θ0`` (boundary edges stay straight chords, paper 001 §6.1).
+    the circle ``θ = θ0`` (boundary edges stay straight chords, Stein et al. 2022 §6.1).
     Outward normals.
 
     Returns
@@ -141,7 +141,7 @@ def schwarz_lantern(m, n, perturbation=0.0, seed=0, radius=1.0, height=1.0):
         Vertices along the axis (rings).
     perturbation : float
         Every vertex moves by ``perturbation · ℓ̄² · ξ`` with ``ℓ̄`` the mean edge
-        length and ``ξ`` uniform in [-1, 1]³ (paper 001, Fig. 4: "perturbed on
+        length and ``ξ`` uniform in [-1, 1]³ (Stein et al. 2022, Fig. 4: "perturbed on
         the order of (mean edge length)²"); boundary rings stay in their planes.
     seed : int
         Seed of the perturbation.
@@ -263,7 +263,7 @@ def _sph(X):
 
 
 class SphericalCapProblem(BiharmonicProblem):
-    """Clamped cap ``θ ≤ θ0`` of the unit sphere, ``u = (θ0 - θ)² θ⁵`` (paper 001, §6.1).
+    """Clamped cap ``θ ≤ θ0`` of the unit sphere, ``u = (θ0 - θ)² θ⁵`` (Stein et al. 2022, §6.1).
 
     ``u = ∂u/∂n = 0`` at θ = θ0 (double root).  θ0 = π/2 is the hemisphere of
     Fig. 2, θ0 = π/4 the cap of Fig. 3.
@@ -399,7 +399,7 @@ class SphereHarmonicsProblem(BiharmonicProblem):
 
 
 class LanternProblem(BiharmonicProblem):
-    """Cylinder of radius 1, z ∈ [0, 1], ``u = cos φ p(z)`` (paper 001, §6.2).
+    """Cylinder of radius 1, z ∈ [0, 1], ``u = cos φ p(z)`` (Stein et al. 2022, §6.2).
 
     ``profile="clamped"``: ``p = sin(πz) z(1 - z)`` (u = ∂u/∂n = 0 at z = 0, 1; the
     paper's case); ``profile="navier"``: ``p = sin(πz)`` (u = Δu = 0 at z = 0, 1).
@@ -504,7 +504,7 @@ class DiskPlateProblem(BiharmonicProblem):
 
 # ---------------------------------------------------------------- errors
 def biharmonic_errors(V, F, u1, u2, problem):
-    """Errors of a mixed solution against the exact one (paper 001, §6).
+    """Errors of a mixed solution against the exact one (Stein et al. 2022, §6).
 
     As in the paper, the exact solution is interpolated at the vertices
     (``I_h u``) and compared in the finite-element norms of the mesh:

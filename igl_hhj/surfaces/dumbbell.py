@@ -1,4 +1,4 @@
-"""Walker's wavy dumbbell (paper 000, §6.2) and the saddle coarse mesh (§6.1).
+"""Walker's wavy dumbbell (Walker 2023, §6.2) and the saddle coarse mesh (§6.1).
 
 The chart domain U is bounded by the four curves of eq. (6.2),
 

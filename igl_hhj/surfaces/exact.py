@@ -6,7 +6,7 @@ solid ``{b < 0}`` lies inside, so ``ν = ∇b/|∇b|`` is the *outward* normal a
     ∇_Γν = P (∇²b) P / |∇b|,   P = I - ν ⊗ ν        (on b = 0),
 
 which gives a sphere of radius R the shape operator P/R (principal
-curvatures +1/R): the sign convention of Walker (paper 000) and libigl.
+curvatures +1/R): the sign convention of Walker (2023) and libigl.
 Graphs ``z = h(x, y)`` use ``b = z - h`` (normal pointing up, +z) and project
 vertically so that the chart domain is preserved.
 """

@@ -1,4 +1,4 @@
-"""Heine's test surfaces (paper 003, eq. 5.1a–5.1d) with exact geometry and coarse meshes.
+"""Heine's test surfaces (Heine 2006, eq. 5.1a–5.1d) with exact geometry and coarse meshes.
 
 (5.1a) ``(x - z²)² + y² + z² - 1 = 0``            :class:`HeineA`
 (5.1b) ``(x - z²)² + (y - z²)² + z² - 1 = 0``     :class:`HeineB`

@@ -1,7 +1,6 @@
-"""Shared plumbing of the demo scripts: command line, mesh loading, tables, rendering.
+"""Shared plumbing of the demos: command line, mesh loading, tables, rendering.
 
-Not part of the library: every demo imports it as ``_common`` (the demos folder
-is on ``sys.path`` when a script runs).
+Used by the modules of :mod:`igl_hhj.demos` only (not public API).
 """
 from __future__ import annotations
 
@@ -11,10 +10,15 @@ import sys
 import numpy as np
 
 
-def parser(doc, *, levels=None, size=(1600, 800)):
+_PROG = [None]   # program name in messages: set by parser() (``igl-hhj demo NAME`` or the script's name)
+
+
+def parser(doc, *, levels=None, size=(1600, 800), prog=None):
     """argparse parser with the demo docstring as description, ``--screenshot``,
-    ``--size`` and (if ``levels`` is given) ``--levels``."""
-    p = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ``--size`` and (if ``levels`` is given) ``--levels``; ``prog`` names the
+    program in usage and error lines (default: the running script's name)."""
+    _PROG[0] = prog
+    p = argparse.ArgumentParser(prog=prog, description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--screenshot", metavar="PNG",
                    help="render headless (EGL) to this PNG and exit instead of opening the viewer")
     p.add_argument("--size", nargs=2, type=int, default=list(size), metavar=("W", "H"),
@@ -27,7 +31,7 @@ def parser(doc, *, levels=None, size=(1600, 800)):
 
 def fail(message, code=2):
     """One-line error on stderr and exit (no traceback for user errors)."""
-    prog = sys.argv[0].rsplit("/", 1)[-1] if sys.argv and sys.argv[0] else "demo"
+    prog = _PROG[0] or (sys.argv[0].rsplit("/", 1)[-1] if sys.argv and sys.argv[0] else "demo")
     print(f"{prog}: error: {message}", file=sys.stderr)
     raise SystemExit(code)
 
@@ -105,8 +109,10 @@ def start_viewer(args):
     """The viewer module, with polyscope started for headless rendering
     (``--screenshot``) or for an interactive window."""
     from igl_hhj import viewer
+    from igl_hhj.mesh_io import CapturedOutput
     try:
-        ps = viewer.init("openGL3_egl" if args.screenshot else "auto")
+        with CapturedOutput():          # polyscope's EGL start-up chatter
+            ps = viewer.init("openGL3_egl" if args.screenshot else "auto")
     except viewer.ViewerUnavailable as exc:
         hint = "" if args.screenshot else " (no display? use --screenshot out.png for headless rendering)"
         fail(f"{exc}{hint}".splitlines()[0], code=1)
