@@ -134,6 +134,8 @@ def _demo(args):
 
     if args.levels < 1:
         raise UserError(f"--levels must be at least 1, got {args.levels}")
+    if min(args.size) < 16:
+        raise UserError(f"--size must be at least 16 16 pixels, got {args.size[0]} {args.size[1]}")
     shot = None if args.no_screenshot else args.screenshot
     if shot is not None:
         _check_writable(shot, (".png",))
@@ -166,7 +168,7 @@ def _demo(args):
             eoc([r[1]["H"] for r in rows], hs)[-1], eoc([r[1]["K"] for r in rows], hs)[-1]))
     if shot is not None:
         try:
-            _demo_screenshot(V, F, surface, PV1, PV2, QV1, QV2, shot)
+            _demo_screenshot(V, F, surface, PV1, PV2, QV1, QV2, shot, tuple(args.size))
         except _viewer().ViewerUnavailable as exc:
             print(f"igl-hhj: warning: no screenshot ({_with_hint(exc)})", file=sys.stderr)
         else:
@@ -175,17 +177,19 @@ def _demo(args):
     return 0
 
 
-def _demo_screenshot(V, F, surface, PV1, PV2, QV1, QV2, path):
+def _demo_screenshot(V, F, surface, PV1, PV2, QV1, QV2, path, size=(1600, 700)):
     """Pointwise |H_h − H| of HHJ and libigl side by side, one shared colour range."""
     viewer = _viewer()
     H = surface.mean_curvature(V)
     err = {"HHJ": np.abs(0.5 * (PV1 + PV2) - H), "libigl": np.abs(0.5 * (QV1 + QV2) - H)}
     top = float(np.nanpercentile(np.concatenate(list(err.values())), 99))
-    shift = np.array([1.1 * np.ptp(V[:, 0]), 0.0, 0.0])
-    regs = [_quietly(viewer.register_scalars, V, F, {f"|H error| ({k})": e}, name=f"demo {k}",
-                     vminmax=(0.0, top), cmap="viridis", offset=i * shift)
+    Vd = V @ viewer.view_rotation("auto", V, F, landscape=True).T   # the side with the largest projected area
+    shift = np.array([1.1 * np.ptp(Vd[:, 0]), 0.0, 0.0])
+    regs = [_quietly(viewer.register_scalars, Vd, F, {"|H error| per vertex": e}, name=f"demo {k}",
+                     vminmax=(0.0, top), cmap="viridis", offset=i * shift,
+                     title=f"{viewer.METHOD_TITLES[k]} — jittered ellipsoid, {len(F):,} faces")
             for i, (k, e) in enumerate(err.items())]
-    _quietly(viewer.screenshot, str(path), regs, size=(1600, 700))
+    _quietly(viewer.screenshot, str(path), regs, size=size)
 
 
 def _with_hint(exc):
@@ -216,6 +220,8 @@ def _curvature(args):
         _check_writable(args.out)
     if args.screenshot is not None:
         _check_writable(args.screenshot, (".png",))
+        if min(args.size) < 16:
+            raise UserError(f"--size must be at least 16 16 pixels, got {args.size[0]} {args.size[1]}")
 
     t = time.perf_counter()
     V, F = _read(args.mesh)
@@ -263,9 +269,10 @@ def _curvature(args):
         viewer = _viewer()
         name = Path(args.mesh).stem
         robust = args.robust if args.robust > 0 else None
+        shown = dict(estimate=est, name=name, robust=robust, enabled=args.quantity, view=args.camera)
         if args.view:            # first: the interactive window cannot open after an EGL render
             try:
-                viewer.register_curvature(mesh.V, mesh.F, estimate=est, name=name, robust=robust)
+                viewer.register_curvature(mesh.V, mesh.F, **shown)
                 viewer.show()
             except viewer.ViewerUnavailable as exc:
                 raise UserError(f"cannot open the viewer window: {_first_line(exc)} "
@@ -273,7 +280,7 @@ def _curvature(args):
         if args.screenshot is not None:
             try:
                 stages.run("screenshot", _quietly, viewer.register_curvature, mesh.V, mesh.F,
-                           estimate=est, name=name, robust=robust, screenshot=str(args.screenshot))
+                           screenshot=str(args.screenshot), size=tuple(args.size), **shown)
             except viewer.ViewerUnavailable as exc:
                 raise UserError(f"no screenshot: {_with_hint(exc)}") from None
             say(f"  wrote {args.screenshot}")
@@ -302,6 +309,21 @@ def _info(args):
 
 
 # --------------------------------------------------------------------------- main
+def _camera(text):
+    """``--camera`` value: a name of :data:`igl_hhj.viewer.VIEWS` or ``X,Y,Z``."""
+    names = ("auto", "+x", "-x", "+y", "-y", "+z", "-z")
+    if text in names:
+        return text
+    try:
+        d = [float(x) for x in text.split(",")]
+    except ValueError:
+        d = []
+    if len(d) != 3 or not np.all(np.isfinite(d)) or not np.any(d):
+        raise argparse.ArgumentTypeError(f"expected one of {', '.join(names)} or a nonzero direction X,Y,Z, "
+                                         f"got {text!r}")
+    return tuple(d)
+
+
 def _version():
     from importlib import metadata
 
@@ -345,6 +367,8 @@ def build_parser():
     d.add_argument("--screenshot", default="igl_hhj_demo.png", metavar="PNG",
                    help="where to write the screenshot (default ./igl_hhj_demo.png)")
     d.add_argument("--no-screenshot", action="store_true", help="only print the table")
+    d.add_argument("--size", type=int, nargs=2, default=(1600, 700), metavar=("W", "H"),
+                   help="screenshot size in pixels (default 1600 700)")
     d.set_defaults(func=_demo)
 
     c = sub.add_parser("curvature", help="curvature of a mesh file (any format libigl reads)",
@@ -364,6 +388,14 @@ def build_parser():
                         "(binary, the values as vertex or face properties)")
     c.add_argument("--view", action="store_true", help="open the polyscope viewer")
     c.add_argument("--screenshot", metavar="PNG", help="render the curvature headless to PNG")
+    c.add_argument("--quantity", choices=["k1", "k2", "H", "K"], default="H",
+                   help="what --view/--screenshot colour and the .ply 'quality' property hold: "
+                        "k1, k2 (principal curvatures), H (mean, default), K (Gauss)")
+    c.add_argument("--camera", type=_camera, default="auto", metavar="DIR",
+                   help="side the --view/--screenshot camera looks from: auto (largest projected "
+                        "area, default), +x, -x, +y, -y, +z, -z, or a direction X,Y,Z")
+    c.add_argument("--size", type=int, nargs=2, default=(1024, 768), metavar=("W", "H"),
+                   help="--screenshot size in pixels (default 1024 768)")
     c.add_argument("--robust", type=float, default=1.0, metavar="P",
                    help="colour range of --view/--screenshot from the P-th to the (100-P)-th "
                         "percentile (default 1; 0: full range)")

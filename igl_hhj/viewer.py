@@ -27,6 +27,15 @@ same curvature) always share one range.  NaN values (undefined, e.g.
 unreferenced vertices) are shown as 0 and kept as NaN in the
 :class:`Registration`.
 
+Screenshots explain themselves: each copy gets a title (method, per face /
+vertex, mesh, face count; ``title=`` overrides it) and the picture a colour
+bar per distinct (quantity, range, colour map) shown, composited with
+matplotlib onto polyscope's render (polyscope 2.6 has no colour bar in
+Python; without matplotlib the plain render is written).  ``view=`` turns the
+mesh for display: ``"auto"`` looks along the direction of largest projected
+area (:func:`best_view_direction`), ``"+x"``, ``"-y"``, ... or a 3-vector
+look from that side.
+
 Principal directions are line fields (polyscope tangent-vector quantities
 with 2-fold symmetry, ``vectortype="ambient"``) on faces or vertices: a
 principal direction has no sign, so it is drawn as a line, not an arrow, and
@@ -47,11 +56,19 @@ __all__ = [
     "init", "show", "color_range", "curvature_estimate", "local_edge_length",
     "register_curvature", "register_comparison", "register_hessian", "register_biharmonic",
     "register_regge_curvature", "register_scalars", "merge", "screenshot",
+    "VIEWS", "best_view_direction", "view_rotation",
 ]
 
 QUANTITIES = ("k1", "k2", "H", "K")
 METHODS = ("hhj", "igl", "heine")
 LABELS = {"k1": "kappa1", "k2": "kappa2", "H": "mean H", "K": "Gauss K"}
+LONG_LABELS = {"k1": "principal curvature κ1", "k2": "principal curvature κ2", "H": "mean curvature H",
+               "K": "Gauss curvature K"}
+"""Colour-bar labels of the curvature quantities."""
+VIEWS = ("auto", "+x", "-x", "+y", "-y", "+z", "-z")
+"""Named ``view=`` directions (the side the camera looks from); a 3-vector works too."""
+METHOD_TITLES = {"HHJ": "HHJ", "libigl": "libigl quadric fit", "Heine": "Heine P1"}
+"""How titles name the estimators (by their tag)."""
 _TAG = {"hhj": "HHJ", "igl": "libigl", "heine": "Heine"}
 _EGL_HINT = ("headless rendering needs EGL: on Debian/Ubuntu `apt-get install libegl1 libegl-mesa0 "
              "libgl1-mesa-dri`")
@@ -74,6 +91,7 @@ class QuantityInfo:
     vminmax : (lo, hi) colour range of a scalar quantity, None for line fields.
     cmap : str or None, colour map of a scalar quantity.
     enabled : bool, shown when the picture opens.
+    label : str or None, what the colour bar calls it (None: the quantity name).
     """
 
     values: np.ndarray
@@ -82,6 +100,7 @@ class QuantityInfo:
     vminmax: tuple | None = None
     cmap: str | None = None
     enabled: bool = False
+    label: str | None = None
 
 
 @dataclass
@@ -96,6 +115,9 @@ class Registration:
         every structure showing that quantity.
     screenshot : str or None, the PNG written (``screenshot=`` argument).
     bounds : (2, 3) float64 or None, bounding box of the registered vertices.
+    titles : dict, structure name -> title drawn above it in screenshots.
+    rotations : dict, structure name -> (3, 3) display rotation (``view=``);
+        the structure shows ``V @ R.T`` (+ offset).
     """
 
     structures: dict = field(default_factory=dict)
@@ -103,6 +125,8 @@ class Registration:
     ranges: dict = field(default_factory=dict)
     screenshot: str | None = None
     bounds: np.ndarray | None = None
+    titles: dict = field(default_factory=dict)
+    rotations: dict = field(default_factory=dict)
 
     def names(self, structure):
         """Quantity names registered on ``structure``."""
@@ -177,8 +201,19 @@ def _reset_after_failed_init(ps):
         pass
 
 
-def show():
+PANEL_PX = 320
+"""Width of polyscope's left-hand panel at UI scale 1 (its 305 px plus a gap)."""
+
+
+def show(*, window=(1600, 900), layout=True):
     """Open polyscope's interactive window on everything registered (needs a display).
+
+    Parameters
+    ----------
+    window : (width, height) of the window in pixels.
+    layout : bool, default True: an orthographic camera framing every
+        registered structure in the part of the window right of polyscope's
+        panel (:data:`PANEL_PX`), so side-by-side copies are all visible.
 
     Raises
     ------
@@ -189,7 +224,23 @@ def show():
     if _backend_name(ps) in ("openGL_mock", "openGL3_egl"):
         raise ViewerUnavailable(f"polyscope is running the windowless {_backend_name(ps)!r} backend; "
                                 "use screenshot=... or run with a display")
+    if layout:
+        _window_layout(ps, window)
     ps.show()
+
+
+def _window_layout(ps, window):
+    """Window size and camera of :func:`show`; returns the camera (``_frame``) or None."""
+    w, h = (int(x) for x in window)
+    ps.set_window_size(w, h)
+    boxes = [_REGISTERED[n] for n in _REGISTERED if ps.has_surface_mesh(n) and ps.get_surface_mesh(n).is_enabled()]
+    if not boxes:
+        return None
+    try:
+        scale = float(ps.get_ui_scale())
+    except Exception:  # pragma: no cover - older polyscope
+        scale = 1.0
+    return _frame(ps, _union_bounds(*boxes), w, h, left_px=min(int(PANEL_PX * scale), w // 2))
 
 
 # --------------------------------------------------------------------------- values
@@ -291,9 +342,132 @@ def _check(value, name, choices):
         raise ValueError(f"{name} must be one of {choices}, got {value!r}")
 
 
+# --------------------------------------------------------------------------- views
+def _fibonacci_sphere(n):
+    i = np.arange(n) + 0.5
+    z = 1.0 - 2.0 * i / n
+    r = np.sqrt(1.0 - z * z)
+    phi = np.pi * (3.0 - np.sqrt(5.0)) * i
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
+
+
+def best_view_direction(V, F, *, n_directions=400, max_faces=50_000):
+    """Unit direction from which the mesh shows its largest projected area.
+
+    The projected area seen from ``d`` is ``½ Σ_T |T| |n_T · d|`` (closed
+    surfaces); it is maximised over ``n_directions`` near-uniform directions (a Fibonacci sphere, plus the axes; at most ``max_faces`` faces,
+    evenly subsampled, enter the sum).  Of ``d`` and ``-d``: on an open
+    surface the side that sees clearly more of it (25 %), otherwise the view
+    from above (+y, the usual "up" of scanned models), then from the front (+z).
+
+    Parameters
+    ----------
+    V : (#V, 3) array_like, F : (#F, 3) array_like int
+
+    Returns
+    -------
+    (3,) float64 unit vector (the side the camera looks from).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from igl_hhj import viewer
+    >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0]]); F = np.array([[0, 1, 2]])
+    >>> np.round(viewer.best_view_direction(V, F), 2).tolist()   # a triangle in the xy plane
+    [0.0, 0.0, 1.0]
+    """
+    V = np.asarray(V, dtype=np.float64)
+    F = np.asarray(F)
+    step = max(1, len(F) // int(max_faces))
+    T = V[F[::step]]
+    N = np.cross(T[:, 1] - T[:, 0], T[:, 2] - T[:, 0])          # 2 |T| n_T
+    D = _fibonacci_sphere(int(n_directions))
+    D = np.vstack([np.eye(3), D[D[:, 2] >= 0]])               # the axes are candidates too
+    seen = N @ D.T                                            # (#T, #D) 2 |T| n_T · d
+    score = np.abs(seen).sum(axis=0)
+    k = int(np.flatnonzero(score >= score.max() * (1 - 1e-9))[0])
+    d = D[k]
+    front, back = np.clip(seen[:, k], 0, None).sum(), np.clip(-seen[:, k], 0, None).sum()
+    if max(front, back) > 1.25 * min(front, back):        # an open surface: look at its larger side
+        flip = back > front
+    else:                                                  # closed: from above (+y), then from the front (+z)
+        flip = d @ np.array([0.1, 1.0, 0.5]) < 0
+    if flip:
+        d = -d
+    return d / np.linalg.norm(d)
+
+
+def view_rotation(view, V=None, F=None, *, landscape=False):
+    """(3, 3) rotation ``R``: ``V @ R.T`` is seen from ``view`` by the screenshots' camera
+    (which looks down -z with y up).
+
+    Parameters
+    ----------
+    view : {"auto", "+x", "-x", "+y", "-y", "+z", "-z"} or (3,) direction
+        The side the camera looks from; "auto" is :func:`best_view_direction`
+        of ``(V, F)``.  The picture's "up" is world +y projected into the view
+        (+z or -z when looking along y).
+    landscape : bool, turn the picture a quarter turn when the mesh ``V``
+        would be taller than wide (copies laid side by side fit better).
+
+    Returns
+    -------
+    (3, 3) float64 orthogonal, det +1; rows: picture right, up, towards the camera.
+
+    Examples
+    --------
+    >>> from igl_hhj import viewer
+    >>> viewer.view_rotation("+z").tolist() == [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
+    True
+    """
+    if isinstance(view, str):
+        _check(view, "view", VIEWS)
+        if view == "auto":
+            if V is None or F is None:
+                raise ValueError("view='auto' needs the mesh (V, F)")
+            d = best_view_direction(V, F)
+        else:
+            d = np.zeros(3)
+            d["xyz".index(view[1])] = 1.0 if view[0] == "+" else -1.0
+    else:
+        d = np.asarray(view, dtype=np.float64).reshape(-1)
+        if d.shape != (3,) or not np.all(np.isfinite(d)) or not np.linalg.norm(d) > 0:
+            raise ValueError(f"view must be one of {VIEWS} or a nonzero 3-vector, got {view!r}")
+        d = d / np.linalg.norm(d)
+    up = np.array([0.0, 1.0, 0.0])
+    if abs(d[1]) > 0.95:                       # looking along y: the front (+z) at the picture's bottom
+        up = np.array([0.0, 0.0, -np.sign(d[1])])
+    u = up - (up @ d) * d
+    u /= np.linalg.norm(u)
+    r = np.cross(u, d)
+    R = np.stack([r, u, d])
+    if landscape and V is not None:            # a quarter turn in the picture if it is taller than wide
+        P = np.asarray(V, dtype=np.float64) @ R[:2].T
+        if np.ptp(P[:, 1]) > np.ptp(P[:, 0]):
+            R = np.stack([u, -r, d])
+    R[np.abs(R) < 1e-15] = 0.0
+    return R
+
+
+def _rotation_for(view, V, F):
+    """None (no rotation) or the (3, 3) display rotation of ``view`` (also accepts a matrix)."""
+    if view is None:
+        return None
+    if not isinstance(view, str) and np.shape(view) == (3, 3):
+        return np.asarray(view, dtype=np.float64)
+    return view_rotation(view, V, F)
+
+
 # --------------------------------------------------------------------------- registration helpers
-def _surface(ps, reg, name, V, F, offset=None):
-    """Register a surface mesh under ``name`` (translated by ``offset``), replacing one of the same name."""
+def _surface(ps, reg, name, V, F, offset=None, view=None, title=None):
+    """Register a surface mesh under ``name`` (turned by ``view``, translated by ``offset``),
+    replacing one of the same name; ``title`` is drawn above it in screenshots."""
+    R = _rotation_for(view, V, F)
+    if R is not None:
+        V = V @ R.T
+        reg.rotations[name] = R
+    if title:
+        reg.titles[name] = str(title)
     if offset is not None:
         off = np.asarray(offset, dtype=np.float64)
         if off.shape != (3,) or not np.all(np.isfinite(off)):
@@ -309,6 +483,14 @@ def _surface(ps, reg, name, V, F, offset=None):
     return s
 
 
+def _title(title, what, name, mesh):
+    """``title`` as given ("" = none), or "<what> — <name>, <#F> faces"."""
+    if title is not None:
+        return str(title)
+    who = "" if name == "mesh" else f"{name}, "
+    return f"{what} — {who}{mesh.n_faces:,} faces"
+
+
 def _union_bounds(*boxes):
     """Bounding box (2, 3) of several (2, 3) boxes (None entries ignored; None if all are)."""
     boxes = [b for b in boxes if b is not None]
@@ -318,11 +500,11 @@ def _union_bounds(*boxes):
     return np.stack([boxes[:, 0].min(axis=0), boxes[:, 1].max(axis=0)])
 
 
-def _scalar(reg, sname, qname, values, defined_on, vminmax, cmap, enabled=False):
+def _scalar(reg, sname, qname, values, defined_on, vminmax, cmap, enabled=False, label=None):
     """Record a scalar quantity; :func:`_add_scalars` hands them to polyscope."""
     values = np.asarray(values, dtype=np.float64)
     reg.quantities[(sname, qname)] = QuantityInfo(values, defined_on, "scalar", tuple(float(x) for x in vminmax),
-                                                  cmap, bool(enabled))
+                                                  cmap, bool(enabled), label)
 
 
 def _add_scalars(reg):
@@ -346,6 +528,10 @@ def _line_field(reg, sname, qname, vectors, normals, defined_on, enabled=False):
     (n, 3), their length is the drawn length."""
     vectors = np.asarray(vectors, dtype=np.float64)
     vectors = np.where(np.isfinite(vectors), vectors, 0.0)
+    computed = vectors
+    R = reg.rotations.get(sname)
+    if R is not None:                        # the structure is displayed turned by R
+        vectors, normals = vectors @ R.T, np.asarray(normals, dtype=np.float64) @ R.T
     length = np.linalg.norm(vectors, axis=1)
     bx = np.zeros_like(vectors)
     np.divide(vectors, length[:, None], out=bx, where=length[:, None] > 0)
@@ -354,7 +540,7 @@ def _line_field(reg, sname, qname, vectors, normals, defined_on, enabled=False):
     values = np.stack([length, np.zeros_like(length)], axis=1)
     reg.structures[sname].add_tangent_vector_quantity(qname, values, bx, by, n_sym=2, defined_on=defined_on,
                                                       vectortype="ambient", enabled=bool(enabled))
-    reg.quantities[(sname, qname)] = QuantityInfo(vectors, defined_on, "line", None, None, bool(enabled))
+    reg.quantities[(sname, qname)] = QuantityInfo(computed, defined_on, "line", None, None, bool(enabled))
 
 
 def _add_estimate(reg, sname, mesh, est, tag, ranges, cmap, directions, direction_scale, enabled=None,
@@ -363,7 +549,7 @@ def _add_estimate(reg, sname, mesh, est, tag, ranges, cmap, directions, directio
     where = "faces" if est.location == "face" else "vertices"
     for q in QUANTITIES:
         _scalar(reg, sname, f"{LABELS[q]} ({tag} {where})", getattr(est, q), where, ranges[q], cmap,
-                enabled=(q == enabled))
+                enabled=(q == enabled), label=LONG_LABELS[q])
     if directions and est.d1 is not None:
         scale = direction_scale * local_edge_length(mesh, est.location)[:, None]
         normals = mesh.face_normals if est.location == "face" else mesh.vertex_normals
@@ -390,7 +576,8 @@ def _finish(reg, screenshot, size):
 # --------------------------------------------------------------------------- curvature
 def register_curvature(V, F, estimate=None, *, method="hhj", per="both", name="mesh", enabled="H",
                        directions=True, show_directions=False, symmetric=True, robust=None, cmap="coolwarm", ranges=None,
-                       direction_scale=0.5, offset=None, screenshot=None, size=(1024, 768), **estimator_kwargs):
+                       direction_scale=0.5, offset=None, view=None, title=None, screenshot=None, size=(1024, 768),
+                       **estimator_kwargs):
     """Register a mesh with its curvature: κ1, κ2, H, K (scalars) and principal directions.
 
     Parameters
@@ -414,6 +601,11 @@ def register_curvature(V, F, estimate=None, *, method="hhj", per="both", name="m
         computed ranges (e.g. to match another picture).
     direction_scale : float, direction length in units of the local mean edge length.
     offset : (3,), optional translation of the structure (to lay out several pictures).
+    view : None, "auto", "+x", "-x", "+y", "-y", "+z", "-z" or (3,), optional:
+        turn the mesh for display so that it is seen from that side
+        (:func:`view_rotation`; None: as given).
+    title : str, optional, the title above the copy in screenshots ("" for
+        none; default: method, per face / vertex, name, face count).
     screenshot : path, optional: render headless to this PNG (see :func:`screenshot`).
     size : (width, height) of the screenshot in pixels.
     **estimator_kwargs : passed to the estimator (boundary data, ``radius``...).
@@ -445,7 +637,9 @@ def register_curvature(V, F, estimate=None, *, method="hhj", per="both", name="m
         for k in ranges:
             _check(k, "ranges key", QUANTITIES)
         reg.ranges.update({k: _explicit_range(v) for k, v in ranges.items()})
-    _surface(ps, reg, name, mesh.V, mesh.F, offset)
+    where = "/".join(dict.fromkeys(e.location for e in ests))
+    _surface(ps, reg, name, mesh.V, mesh.F, offset, view,
+             _title(title, f"{METHOD_TITLES.get(tags[0], tags[0])}, per {where}", name, mesh))
     for i, (est, tag) in enumerate(zip(ests, tags)):
         _add_estimate(reg, name, mesh, est, tag, reg.ranges, cmap, directions, direction_scale,
                       enabled=enabled if i == 0 else None, show_directions=show_directions and i == 0)
@@ -473,7 +667,7 @@ def _check_sizes(mesh, ests):
 
 def register_comparison(V, F, *, hhj=None, libigl=None, per="face", layout="copy", name="mesh", enabled="H",
                         directions=True, show_directions=False, symmetric=True, robust=None, cmap="coolwarm", offset=None,
-                        direction_scale=0.5, radius=5, screenshot=None, size=(1600, 800)):
+                        direction_scale=0.5, radius=5, view=None, title=None, screenshot=None, size=(1600, 800)):
     """HHJ curvature beside ``igl.principal_curvature`` on the same mesh, identical colour ranges.
 
     Parameters
@@ -489,6 +683,9 @@ def register_comparison(V, F, *, hhj=None, libigl=None, per="face", layout="copy
     offset : (3,) translation of the libigl copy; default 1.15 × the bounding
         box width along x.
     radius : libigl's ``radius`` (k-ring size).
+    view : as :func:`register_curvature`; both copies are turned alike.
+    title : str or (str, str), optional: the copies' titles ("" for none;
+        default: method, per face / vertex, name, face count).
     other parameters : as :func:`register_curvature`.
 
     Returns
@@ -509,16 +706,21 @@ def register_comparison(V, F, *, hhj=None, libigl=None, per="face", layout="copy
     reg = Registration()
     reg.ranges = {q: color_range(getattr(hhj, q), getattr(libigl, q), symmetric=symmetric, robust=robust)
                   for q in QUANTITIES}
+    R = _rotation_for(view, mesh.V, mesh.F)
+    titles = (title, title) if title is None or isinstance(title, str) else tuple(title)
+    t_hhj = _title(titles[0], f"HHJ, per {hhj.location}", name, mesh)
+    t_igl = _title(titles[1], "libigl quadric fit, per vertex", name, mesh)
     if layout == "copy":
         if offset is None:
-            ext = mesh.V.max(axis=0) - mesh.V.min(axis=0)
+            Vd = mesh.V if R is None else mesh.V @ R.T
+            ext = Vd.max(axis=0) - Vd.min(axis=0)
             offset = np.array([1.15 * ext[0], 0.0, 0.0])
         sh, si = f"{name} HHJ", f"{name} libigl"
-        _surface(ps, reg, sh, mesh.V, mesh.F)
-        _surface(ps, reg, si, mesh.V, mesh.F, np.asarray(offset, dtype=np.float64).reshape(3))
+        _surface(ps, reg, sh, mesh.V, mesh.F, None, R, t_hhj)
+        _surface(ps, reg, si, mesh.V, mesh.F, np.asarray(offset, dtype=np.float64).reshape(3), R, t_igl)
     else:
         sh = si = name
-        _surface(ps, reg, name, mesh.V, mesh.F)
+        _surface(ps, reg, name, mesh.V, mesh.F, None, R, t_hhj)
     _add_estimate(reg, sh, mesh, hhj, "HHJ", reg.ranges, cmap, directions, direction_scale, enabled=enabled,
                   show_directions=show_directions)
     _add_estimate(reg, si, mesh, libigl, "libigl", reg.ranges, cmap, directions, direction_scale,
@@ -529,7 +731,7 @@ def register_comparison(V, F, *, hhj=None, libigl=None, per="face", layout="copy
 # --------------------------------------------------------------------------- other fields
 def register_hessian(V, F, w, *, boundary_gradient=None, name="mesh", label="w", enabled="trace",
                      directions=True, symmetric=True, robust=None, cmap="coolwarm", direction_scale=0.5,
-                     offset=None, screenshot=None, size=(1024, 768)):
+                     offset=None, view=None, title=None, screenshot=None, size=(1024, 768)):
     """Register a P1 function ``w`` and its HHJ surface Hessian (Walker eq. 4.9).
 
     Parameters
@@ -539,6 +741,11 @@ def register_hessian(V, F, w, *, boundary_gradient=None, name="mesh", label="w",
     label : str, name of the function in the quantity names.
     enabled : {"w", "lambda1", "lambda2", "trace", "norm"}, quantity shown first.
     offset : (3,), optional translation of the structure.
+    view : None, "auto", "+x", "-x", "+y", "-y", "+z", "-z" or (3,), optional:
+        turn the mesh for display so that it is seen from that side
+        (:func:`view_rotation`; None: as given).
+    title : str, optional, the title above the copy in screenshots ("" for
+        none; default: method, per face / vertex, name, face count).
 
     Registered (on structure ``name``): ``w`` (vertices, viridis), the
     eigenvalues λ1 ≥ λ2 of the tangential Hessian and its trace (the surface
@@ -569,9 +776,10 @@ def register_hessian(V, F, w, *, boundary_gradient=None, name="mesh", label="w",
                   "lambda": color_range(l1, l2, symmetric=symmetric, robust=robust),
                   "trace": color_range(tr, symmetric=symmetric, robust=robust),
                   "norm": color_range(nrm, symmetric=False, robust=robust)}
-    _surface(ps, reg, name, mesh.V, mesh.F, offset)
     names = {"w": label, "lambda1": f"Hess {label} lambda1", "lambda2": f"Hess {label} lambda2",
              "trace": f"Hess {label} trace (surface Laplacian)", "norm": f"|Hess {label}|"}
+    _surface(ps, reg, name, mesh.V, mesh.F, offset, view,
+             _title(title, label if enabled == "w" else f"HHJ {names[enabled]}, per face", name, mesh))
     for key, vals, where, rng, cm in (("w", wv, "vertices", "w", "viridis"),
                                       ("lambda1", l1, "faces", "lambda", cmap),
                                       ("lambda2", l2, "faces", "lambda", cmap),
@@ -590,7 +798,8 @@ _BIHARMONIC_LABELS = {"u1": "u1 (approx. u)", "u2": "u2 (approx. -Laplacian u)",
 
 
 def register_biharmonic(V, F, u1, u2=None, *, exact=None, f=None, name="mesh", enabled="u1", symmetric=None,
-                        robust=None, ranges=None, offset=None, screenshot=None, size=(1024, 768)):
+                        robust=None, ranges=None, offset=None, view=None, title=None, screenshot=None,
+                        size=(1024, 768)):
     """Register a mixed-P1 biharmonic solution (Stein et al.): ``u1 ≈ u``, ``u2 ≈ -Δu``.
 
     Parameters
@@ -604,6 +813,11 @@ def register_biharmonic(V, F, u1, u2=None, *, exact=None, f=None, name="mesh", e
         change sign, else a sequential ``viridis`` range.
     ranges : dict, optional explicit ranges by key ("u1", "u2", "f", "error").
     offset : (3,), optional translation of the structure.
+    view : None, "auto", "+x", "-x", "+y", "-y", "+z", "-z" or (3,), optional:
+        turn the mesh for display so that it is seen from that side
+        (:func:`view_rotation`; None: as given).
+    title : str, optional, the title above the copy in screenshots ("" for
+        none; default: method, per face / vertex, name, face count).
 
     Returns
     -------
@@ -631,7 +845,8 @@ def register_biharmonic(V, F, u1, u2=None, *, exact=None, f=None, name="mesh", e
     _check(enabled, "enabled", tuple(fields))
     ps = _polyscope_for(screenshot)
     reg = Registration()
-    _surface(ps, reg, name, mesh.V, mesh.F, offset)
+    _surface(ps, reg, name, mesh.V, mesh.F, offset, view,
+             _title(title, f"mixed P1 biharmonic: {_BIHARMONIC_LABELS[enabled]}", name, mesh))
     for key in ("u1", "u2", "f", "error"):
         if key not in fields:
             continue
@@ -645,13 +860,13 @@ def register_biharmonic(V, F, u1, u2=None, *, exact=None, f=None, name="mesh", e
         cm = "coolwarm" if sym else "viridis"
         for k in [key] + (["u"] if key == "u1" and "u" in fields else []):
             _scalar(reg, name, _BIHARMONIC_LABELS[k], fields[k], "vertices", reg.ranges[key], cm,
-                    enabled=(k == enabled))
+                    enabled=(k == enabled), label="u1 and exact u" if key == "u1" and "u" in fields else None)
     return _finish(reg, screenshot, size)
 
 
 def register_regge_curvature(V, F, *, boundary="natural", mass="consistent", compare=True, name="mesh",
                              enabled="K_h", symmetric=True, robust=None, cmap="coolwarm", vminmax=None,
-                             offset=None, screenshot=None, size=(1024, 768)):
+                             offset=None, view=None, title=None, screenshot=None, size=(1024, 768)):
     """Register the Regge (degree-0, edge-length metric) Gauss curvature K_h (Gopalakrishnan et al. 2024).
 
     Parameters
@@ -664,6 +879,11 @@ def register_regge_curvature(V, F, *, boundary="natural", mass="consistent", com
     vminmax : (lo, hi), optional explicit range (e.g. shared with other pictures);
         default: :func:`color_range` of K_h.
     offset : (3,), optional translation of the structure.
+    view : None, "auto", "+x", "-x", "+y", "-y", "+z", "-z" or (3,), optional:
+        turn the mesh for display so that it is seen from that side
+        (:func:`view_rotation`; None: as given).
+    title : str, optional, the title above the copy in screenshots ("" for
+        none; default: method, per face / vertex, name, face count).
 
     Returns
     -------
@@ -691,14 +911,18 @@ def register_regge_curvature(V, F, *, boundary="natural", mass="consistent", com
     reg = Registration()
     reg.ranges["K"] = (_explicit_range(vminmax) if vminmax is not None
                        else color_range(Kh, symmetric=symmetric, robust=robust))
-    _surface(ps, reg, name, mesh.V, mesh.F, offset)
+    what = {"K_h": "Regge K_h, per vertex", "angle_defect": "angle defect / area, per vertex",
+            "hhj": "HHJ Gauss K, per face"}[enabled]
+    _surface(ps, reg, name, mesh.V, mesh.F, offset, view, _title(title, what, name, mesh))
     for key, (qname, vals, where) in fields.items():
-        _scalar(reg, name, qname, vals, where, reg.ranges["K"], cmap, enabled=(key == enabled))
+        _scalar(reg, name, qname, vals, where, reg.ranges["K"], cmap, enabled=(key == enabled),
+                label="Gauss curvature K")
     return _finish(reg, screenshot, size)
 
 
 def register_scalars(V, F, fields, *, name="mesh", enabled=None, shared_range=False, symmetric=True, robust=None,
-                     cmap="coolwarm", vminmax=None, offset=None, screenshot=None, size=(1024, 768)):
+                     cmap="coolwarm", vminmax=None, offset=None, view=None, title=None, screenshot=None,
+                     size=(1024, 768)):
     """Register arbitrary per-vertex / per-face scalar fields (errors, indicators, ...).
 
     Parameters
@@ -711,6 +935,9 @@ def register_scalars(V, F, fields, *, name="mesh", enabled=None, shared_range=Fa
     vminmax : (lo, hi), optional, one explicit range for every field (e.g. the
         same range as another structure's picture).
     offset : (3,) translation of the structure (to lay out several pictures).
+    view : as :func:`register_curvature`.
+    title : str, optional, the title above the copy in screenshots ("" for
+        none; default: ``name`` (or the shown field's name), face count).
 
     Returns
     -------
@@ -739,7 +966,8 @@ def register_scalars(V, F, fields, *, name="mesh", enabled=None, shared_range=Fa
         common = _explicit_range(vminmax)
     else:
         common = color_range(*vals.values(), symmetric=symmetric, robust=robust) if shared_range else None
-    _surface(ps, reg, name, mesh.V, mesh.F, offset)
+    _surface(ps, reg, name, mesh.V, mesh.F, offset, view,
+             _title(title, name if name != "mesh" else str(enabled), "mesh", mesh))
     for k, x in vals.items():
         reg.ranges[k] = common or color_range(x, symmetric=symmetric, robust=robust)
         _scalar(reg, name, k, x, where[k], reg.ranges[k], cmap, enabled=(k == enabled))
@@ -753,6 +981,8 @@ def merge(*registrations):
         out.structures.update(r.structures)
         out.quantities.update(r.quantities)
         out.ranges.update(r.ranges)
+        out.titles.update(r.titles)
+        out.rotations.update(r.rotations)
     out.bounds = _union_bounds(*(r.bounds for r in registrations))
     return out
 
@@ -777,15 +1007,29 @@ def _check_screenshot(path, size):
     return path
 
 
-def _render(reg, path, size):
-    """Write a PNG of the structures of ``reg`` (others hidden during the shot)."""
+def _render(reg, path, size, annotate=True):
+    """Write a PNG of the structures of ``reg`` (others hidden during the shot), with
+    titles and colour bars composited on (``annotate``, needs matplotlib)."""
     path = _check_screenshot(path, size)
     w, h = (int(x) for x in size)
     import polyscope as ps
     if not ps.is_initialized() or _backend_name(ps) == "openGL_mock":
         raise ViewerUnavailable("polyscope's mock backend draws nothing; register with screenshot=... "
                                 "(which starts the EGL backend) or call viewer.init('openGL3_egl') first")
-    ps.set_window_size(w, h)
+    bars = _colour_bars(reg) if annotate else []
+    titles = {n: t for n, t in reg.titles.items() if t and n in reg.structures} if annotate else {}
+    if (bars or titles) and not _have_matplotlib():
+        import warnings
+        warnings.warn("matplotlib is not installed: screenshot written without titles and colour bars",
+                      stacklevel=3)
+        bars, titles = [], {}
+    font = _font_px(w, h)
+    bar_px = int(round(3.8 * font)) if bars else 0
+    top_px = int(round(1.7 * font)) if titles else 0
+    h_img = h - bar_px
+    if h_img < 16:
+        bars, bar_px, h_img = [], 0, h
+    ps.set_window_size(w, h_img)
     ps.set_ground_plane_mode("none")
     projection = ps.get_view_projection_mode()
     # look structures up by name: a Python handle of a removed structure must never be touched
@@ -800,11 +1044,16 @@ def _render(reg, path, size):
     for n in reg.structures:
         ps.get_surface_mesh(n).set_enabled(True)
     try:
+        camera = None
         if reg.bounds is not None:
-            _frame(ps, reg.bounds, w, h)
+            camera = _frame(ps, reg.bounds, w, h_img, top_px=top_px)
         else:
             ps.reset_camera_to_home_view()
-        ps.screenshot(path, transparent_bg=False)
+        if bars or titles:
+            image = np.asarray(ps.screenshot_to_buffer(transparent_bg=False))
+            _compose(path, image, (w, h), bars, _title_positions(titles, camera, w, h_img), font)
+        else:
+            ps.screenshot(path, transparent_bg=False)
     finally:
         for s in hidden:
             s.set_enabled(True)
@@ -814,31 +1063,136 @@ def _render(reg, path, size):
     return path
 
 
-def _frame(ps, bounds, width, height, margin=0.04):
+def _have_matplotlib():
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def _font_px(w, h):
+    """Text height in pixels for a ``w`` x ``h`` picture."""
+    return float(np.clip(min(w, 1.6 * h) / 75.0, 7.0, 18.0))
+
+
+def _colour_bars(reg):
+    """[(label, (lo, hi), cmap)] of the scalar quantities shown (enabled) on the
+    structures of ``reg``: one bar per distinct label, range and colour map."""
+    bars = {}
+    for (sname, qname), q in reg.quantities.items():
+        if q.kind == "scalar" and q.enabled and sname in reg.structures:
+            bars.setdefault((q.label or qname, tuple(q.vminmax), q.cmap or "viridis"), None)
+    return list(bars)
+
+
+def _title_positions(titles, camera, w, h_img):
+    """[(text, x_px, y_px)]: each title centred above its structure's box (pixels, y down)."""
+    out = []
+    for name, text in titles.items():
+        box = _REGISTERED.get(name)
+        if camera is None or box is None:
+            out.append((text, 0.5 * w, 0.0))
+            continue
+        (cx, cy), wpp = camera
+        x = 0.5 * w + (0.5 * (box[0, 0] + box[1, 0]) - cx) / wpp
+        y = 0.5 * h_img - (box[1, 1] - cy) / wpp
+        out.append((text, float(np.clip(x, 0, w)), float(np.clip(y, 0, h_img))))
+    return out
+
+
+_CMAP_NAMES = {"blues": "Blues", "reds": "Reds", "spectral": "Spectral", "phase": "hsv", "pink": "pink"}
+
+
+def _mpl_cmap(name):
+    import matplotlib
+    for n in (name, _CMAP_NAMES.get(name, name), str(name).lower()):
+        try:
+            return matplotlib.colormaps[n]
+        except KeyError:
+            continue
+    return matplotlib.colormaps["viridis"]
+
+
+def _tick_text(x):
+    return "0" if x == 0 else f"{x:.3g}"
+
+
+def _compose(path, image, size, bars, titles, font):
+    """Save ``image`` (polyscope's render, (h_img, w, 3|4) uint8) with ``titles``
+    (text, x, y) drawn on it and horizontal colour bars below, as a ``size`` PNG."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.colorbar import ColorbarBase
+    from matplotlib.colors import Normalize
+    from matplotlib.figure import Figure
+    w, h = size
+    h_img, w_img = image.shape[:2]
+    dpi = 100.0
+    pt = font * 72.0 / dpi
+    fig = Figure(figsize=(w / dpi, h / dpi), dpi=dpi, facecolor="white")
+    FigureCanvasAgg(fig)
+    ax = fig.add_axes((0.0, 1.0 - h_img / h, w_img / w, h_img / h))
+    ax.imshow(image[..., :3], extent=(0, w_img, h_img, 0), interpolation="nearest")
+    ax.set_xlim(0, w_img)
+    ax.set_ylim(h_img, 0)
+    ax.set_axis_off()
+    for text, x, y in titles:
+        ha = "left" if x < 0.08 * w else "right" if x > 0.92 * w else "center"
+        ax.text(x, max(y - 0.25 * font, 1.15 * font), text, ha=ha, va="bottom", fontsize=pt, color="0.1",
+                clip_on=False)
+    if bars:
+        bar_h = h - h_img
+        slot = w / len(bars)
+        for i, (label, (lo, hi), cmap) in enumerate(bars):
+            width = min(0.7 * slot, 0.45 * w)
+            left = i * slot + 0.5 * (slot - width)
+            cax = fig.add_axes((left / w, 1.7 * font / h, width / w, 0.55 * font / h))
+            cb = ColorbarBase(cax, cmap=_mpl_cmap(cmap), norm=Normalize(lo, hi), orientation="horizontal")
+            ticks = [lo, 0.0, hi] if lo < 0 < hi else [lo, hi]
+            cb.set_ticks(ticks)
+            cb.set_ticklabels([_tick_text(t) for t in ticks])
+            cax.tick_params(labelsize=0.9 * pt, length=2, pad=1)
+            cb.outline.set_linewidth(0.5)
+            cax.set_title(label, fontsize=pt, pad=0.6 * pt)
+    fig.savefig(path, dpi=dpi, facecolor="white")
+
+
+def _frame(ps, bounds, width, height, margin=0.04, top_px=0, left_px=0):
     """Orthographic camera on +z (looking down -z, y up) framing the box ``bounds``:
-    its x or y extent, whichever is binding, fills the picture up to ``margin``.
+    its x or y extent, whichever is binding, fills the picture up to ``margin``,
+    leaving ``top_px`` pixels free at the top (titles) and ``left_px`` at the
+    left (polyscope's panel in the interactive window).
 
     Orthographic so that copies laid side by side are seen from the same
     direction.  polyscope's own home view frames the bounding-box diagonal,
     which leaves wide pictures mostly empty and crops tall objects.  In
     polyscope's orthographic mode the visible half-height is
     ``2 tan(fov/2) × length_scale`` (measured), so the length scale sets the zoom.
+
+    Returns
+    -------
+    ((cx, cy), wpp): the world point at the picture's centre and the world
+    length of one pixel.
     """
     lo, hi = np.asarray(bounds[0], dtype=np.float64), np.asarray(bounds[1], dtype=np.float64)
     centre, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
     diag = float(np.linalg.norm(hi - lo)) or 1.0
     tan_v = np.tan(np.radians(ps.get_vertical_fov_degrees()) / 2.0)
-    half_height = (1.0 + margin) * max(half[1], half[0] * height / width, 1e-9 * diag)
+    free_h, free_w = max(height - top_px, 1), max(width - left_px, 1)
+    wpp = (1.0 + margin) * 2.0 * max(half[1] / free_h, half[0] / free_w, 1e-9 * diag / height)
+    half_height = 0.5 * height * wpp
     scale = half_height / (2.0 * tan_v)
     ps.set_automatically_compute_scene_extents(False)   # hidden structures must not count
     ps.set_bounding_box(lo, hi)
     ps.set_length_scale(scale)
     ps.set_view_projection_mode("orthographic")
+    target = centre + np.array([-0.5 * left_px * wpp, 0.5 * top_px * wpp, 0.0])
     # clip planes are multiples of the length scale: keep the camera just in front of the box
-    ps.look_at(centre + np.array([0.0, 0.0, half[2] + 0.5 * scale]), centre)
+    ps.look_at(target + np.array([0.0, 0.0, half[2] + 0.5 * scale]), target)
+    return (float(target[0]), float(target[1])), wpp
 
 
-def screenshot(path, registration=None, *, size=(1024, 768)):
+def screenshot(path, registration=None, *, size=(1024, 768), annotate=True):
     """Render headless (EGL, unless an interactive backend is running) and save a PNG.
 
     Parameters
@@ -847,7 +1201,10 @@ def screenshot(path, registration=None, *, size=(1024, 768)):
     registration : Registration or list of them, optional: only their
         structures are drawn (everything registered through this module
         otherwise).
-    size : (width, height) in pixels.
+    size : (width, height) in pixels of the whole picture.
+    annotate : bool, default True: titles above the copies and a colour bar
+        (quantity name, range, colour map) per distinct shown quantity, drawn
+        with matplotlib (plain render with a warning when it is missing).
 
     Returns
     -------
@@ -865,4 +1222,4 @@ def screenshot(path, registration=None, *, size=(1024, 768)):
                                     bounds=_union_bounds(*(_REGISTERED[n] for n in names)))
     elif isinstance(registration, (list, tuple)):
         registration = merge(*registration)
-    return _render(registration, path, size)
+    return _render(registration, path, size, annotate)

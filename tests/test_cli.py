@@ -295,6 +295,13 @@ def test_curvature_view_registers_the_estimate(sphere, monkeypatch, capsys):
     (nv, nf, kw), shown = calls
     assert (nv, nf) == (len(V), len(F)) and shown == "show"
     assert kw["name"] == "sphere" and kw["estimate"].location == "face" and kw["robust"] == 1.0
+    assert kw["enabled"] == "H" and kw["view"] == "auto"
+    calls.clear()
+    assert cli.main(["curvature", str(path), "--view", "--quantity", "K", "--camera", "1,0,-2"]) == 0
+    assert calls[0][2]["enabled"] == "K" and calls[0][2]["view"] == (1.0, 0.0, -2.0)
+    for bad in ("0,0,0", "up", "1,2"):
+        assert cli.main(["curvature", str(path), "--camera", bad]) == 2
+        assert "--camera" in one_error_line(capsys.readouterr().err)
 
 
 def test_viewer_unavailable_is_a_user_error(sphere, tmp_path, monkeypatch, capsys):

@@ -342,3 +342,77 @@ def test_registration_repr_is_short(mock, ellipsoid):
     text = repr(reg)
     assert len(text) < 400 and "array" not in text
     assert "'r HHJ'" in text and "mean H (HHJ faces)" in text
+
+
+# --------------------------------------------------------------------------- views, titles, colour bars (issue 14)
+@pytest.mark.parametrize("view", ["+x", "-x", "+y", "-y", "+z", "-z", (1.0, 2.0, -0.5)])
+def test_view_rotation_is_a_rotation_looking_from_view(view):
+    R = viewer.view_rotation(view)
+    np.testing.assert_allclose(R @ R.T, np.eye(3), atol=1e-12)
+    assert np.linalg.det(R) == pytest.approx(1.0)
+    d = np.zeros(3)
+    if isinstance(view, str):
+        d["xyz".index(view[1])] = 1.0 if view[0] == "+" else -1.0
+    else:
+        d = np.asarray(view) / np.linalg.norm(view)
+    np.testing.assert_allclose(R @ d, [0, 0, 1], atol=1e-12)   # the camera (on +z) looks from `view`
+
+
+def test_best_view_is_the_largest_projected_area(ellipsoid):
+    """Ellipsoid x² + (2y)² + (2z/3)² = 1: the largest silhouette (the x-z ellipse, area
+    π·1·1.5, against π·1·0.5 and π·0.5·1.5) is seen along the short y axis; an open
+    hemisphere is seen from its outer (convex) side."""
+    V, F = ellipsoid
+    d = viewer.best_view_direction(V, F)
+    assert abs(d[1]) > 0.97, d
+    V2, F2 = icosphere(3)
+    keep = (V2[F2][:, :, 2] > -1e-9).all(axis=1)
+    d2 = viewer.best_view_direction(V2, F2[keep])
+    assert d2[2] > 0.97, d2
+    with pytest.raises(ValueError, match="view must be one of"):
+        viewer.view_rotation((0, 0, 0))
+    with pytest.raises(ValueError, match="view must be one of"):
+        viewer.view_rotation("top")
+
+
+def test_titles_and_turned_copies(mock, ellipsoid):
+    V, F = ellipsoid
+    plain = viewer.register_comparison(V, F, name="cmp")
+    assert plain.titles == {"cmp HHJ": f"HHJ, per face — cmp, {len(F):,} faces",
+                            "cmp libigl": f"libigl quadric fit, per vertex — cmp, {len(F):,} faces"}
+    assert viewer.register_curvature(V, F, name="c", title="").titles == {}
+    turned = viewer.register_comparison(V, F, name="cmp", view="+x")
+    R = viewer.view_rotation("+x")
+    np.testing.assert_allclose(turned.rotations["cmp HHJ"], R)
+    box = viewer._REGISTERED["cmp HHJ"]
+    np.testing.assert_allclose(box, [(V @ R.T).min(axis=0), (V @ R.T).max(axis=0)])
+    # the registration keeps the values as computed (directions in the mesh's own coordinates)
+    for key, q in plain.quantities.items():
+        np.testing.assert_allclose(turned.quantities[key].values, q.values)
+    # colour bars: one per (label, range, colour map) shown
+    assert viewer._colour_bars(plain) == [("mean curvature H", plain.ranges["H"], "coolwarm")]
+
+
+def test_screenshot_has_a_colour_bar(egl, sphere, tmp_path):
+    """The unit sphere has H = 1 > 0 everywhere: without annotation no blue pixel; the
+    coolwarm colour bar below the picture brings its blue half (and the dark tick text)."""
+    V, F = sphere
+    reg = viewer.register_curvature(V, F, name="s", per="face", robust=None)
+    viewer.screenshot(tmp_path / "plain.png", reg, size=(400, 300), annotate=False)
+    viewer.screenshot(tmp_path / "bar.png", reg, size=(400, 300))
+    plain, bar = png_stats(tmp_path / "plain.png"), png_stats(tmp_path / "bar.png")
+    assert (bar["width"], bar["height"]) == (400, 300)
+    assert plain["blue"] < 1e-4 and bar["blue"] > 2e-3, (plain, bar)
+    import matplotlib.image as mpimg
+    im = mpimg.imread(str(tmp_path / "bar.png"))[..., :3]
+    assert (im[:20].min(axis=2) < 0.3).any()          # the title's dark text at the top
+
+
+def test_interactive_layout_leaves_the_panel_free(egl, ellipsoid):
+    V, F = ellipsoid
+    viewer.register_comparison(V, F, name="win")
+    (cx, cy), wpp = viewer._window_layout(ps, (1200, 700))
+    lo = min(viewer._REGISTERED[n][0, 0] for n in ("win HHJ", "win libigl"))
+    hi = max(viewer._REGISTERED[n][1, 0] for n in ("win HHJ", "win libigl"))
+    left_px, right_px = 600 + (lo - cx) / wpp, 600 + (hi - cx) / wpp
+    assert viewer.PANEL_PX <= left_px and right_px <= 1200, (left_px, right_px)

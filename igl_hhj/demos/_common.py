@@ -136,11 +136,12 @@ def finish(viewer, args, registrations):
             fail(f"{str(exc).splitlines()[0]} (use --screenshot out.png for headless rendering)", code=1)
 
 
-def register_field(viewer, V, F, label, values, vrange, *, name, offset=None, cmap="viridis"):
+def register_field(viewer, V, F, label, values, vrange, *, name, offset=None, cmap="viridis", title=None):
     """One structure carrying one scalar field coloured on the given range ``vrange``
-    (several of them laid side by side share one range)."""
+    (several of them laid side by side share one range and one colour bar);
+    ``title`` is drawn above it in screenshots."""
     return viewer.register_scalars(V, F, {label: values}, name=name, offset=offset, cmap=cmap,
-                                   vminmax=tuple(vrange))
+                                   vminmax=tuple(vrange), title=title)
 
 
 def error_range(*arrays, robust=1.0):

@@ -82,10 +82,12 @@ def show(rows, prob, R, args):
     u = prob.u(last["V"])                           # exact u at the (unrotated) vertices
     f = prob.f(last["V"])
     ext = V.max(axis=0) - V.min(axis=0)
+    where = f"{prob.name}, bc={args.bc}, {last['faces']:,} faces"
     left = viewer.register_biharmonic(V, last["F"], last["u1"], last["u2"], exact=u, f=f, name="u1",
-                                      enabled="u1")
+                                      enabled="u1", title=f"computed u1 — {where}")
     right = viewer.register_biharmonic(V, last["F"], last["u1"], last["u2"], exact=u, f=f, name="error u1 - u",
-                                       enabled="error", offset=(1.15 * ext[0], 0.0, 0.0))
+                                       enabled="error", offset=(1.15 * ext[0], 0.0, 0.0),
+                                       title=f"error u1 - u — {where}")
     lo, hi = left.ranges["u1"]
     elo, ehi = right.ranges["error"]
     print(f"colour ranges: u1 and u [{lo:.3g}, {hi:.3g}]; error u1 - u [{elo:.3g}, {ehi:.3g}]")

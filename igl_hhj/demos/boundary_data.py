@@ -96,8 +96,9 @@ def show(rows, args):
     vrange = _common.error_range(*last["field"].values(), robust=1.0)
     offsets = _common.grid_offsets(V, len(KINDS), 1)[0]
     regs = [_common.register_field(viewer, V, last["mesh"].F, "|S_h - S|", last["field"][lab], vrange,
-                                   name=f"{args.surface} {lab}", offset=off)
-            for (lab, _), off in zip(KINDS, offsets)]
+                                   name=f"{args.surface} {lab}", offset=off,
+                                   title=f"({'abc'[i]}) {lab} — {args.surface}, {last['faces']:,} faces")
+            for i, ((lab, _), off) in enumerate(zip(KINDS, offsets))]
     print(f"colour range of |S_h - S| (all copies, {last['faces']} faces): [0, {vrange[1]:.3g}]")
     _common.finish(viewer, args, regs)
 

@@ -104,6 +104,8 @@ def main(argv=None, prog=None):
     p.add_argument("--robust", type=float, default=1.0, metavar="P",
                    help="colour range from the [P, 100-P] percentiles of both methods' values "
                         "(default 1; 0 = the extremes)")
+    p.add_argument("--camera", default="auto", choices=["auto", "+x", "-x", "+y", "-y", "+z", "-z"],
+                   help="mesh file: the side the camera looks from (default auto: largest projected area)")
     args = p.parse_args(argv)
     if args.robust is not None and not 0 <= args.robust < 50:
         _common.fail(f"--robust must be a percentile in [0, 50), got {args.robust}")
@@ -120,7 +122,10 @@ def main(argv=None, prog=None):
     else:
         percentile_table(hhj, igl_, (th, ti))
     viewer = _common.start_viewer(args)
-    reg = viewer.register_comparison(V, F, hhj=hhj, libigl=igl_, enabled=args.quantity, robust=args.robust)
+    from pathlib import Path
+    name = Path(args.mesh).stem if args.mesh else f"jittered {args.surface}"
+    reg = viewer.register_comparison(V, F, hhj=hhj, libigl=igl_, enabled=args.quantity, robust=args.robust,
+                                     name=name, view=args.camera if args.mesh else None)
     lo, hi = reg.ranges[args.quantity]
     print(f"colour range of {args.quantity} (both copies): [{lo:.3g}, {hi:.3g}]")
     _common.finish(viewer, args, [reg])

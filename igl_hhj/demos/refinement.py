@@ -103,9 +103,10 @@ def show(rows, args):
     regs = []
     for i, (lab, _) in enumerate(METHODS):
         for k, r in enumerate(rows):
-            regs.append(_common.register_field(viewer, r["mesh"].V @ DISPLAY.T, r["mesh"].F, "|H error|",
+            regs.append(_common.register_field(viewer, r["mesh"].V @ DISPLAY.T, r["mesh"].F, "|H_h - H|",
                                                r["field"][lab], vrange, name=f"{lab} level {k}",
-                                               offset=offsets[i][k]))
+                                               offset=offsets[i][k],
+                                               title=f"{lab}, level {k}: {r['faces']:,} faces"))
     print(f"colour range of |H_h - H| (all copies): [0, {vrange[1]:.3g}] ({100 - ROBUST:g}th percentile)")
     _common.finish(viewer, args, regs)
 

@@ -124,12 +124,15 @@ def show(mesh, surface, args, rotate):
     else:
         K = surface.gauss_curvature(mesh.V)
         vrange = viewer.color_range(K)
-    left = viewer.register_regge_curvature(V, mesh.F, name="Regge K_h", enabled="K_h", vminmax=vrange)
-    mid = viewer.register_regge_curvature(V, mesh.F, name="HHJ K", enabled="hhj", vminmax=vrange, offset=step)
+    faces = f"{mesh.n_faces:,} faces"
+    left = viewer.register_regge_curvature(V, mesh.F, name="Regge K_h", enabled="K_h", vminmax=vrange,
+                                           title=f"Regge K_h (edge lengths), per vertex — {faces}")
+    mid = viewer.register_regge_curvature(V, mesh.F, name="HHJ K", enabled="hhj", vminmax=vrange, offset=step,
+                                          title=f"HHJ det(S_h + ν⊗ν), per face — {faces}")
     regs = [left, mid]
     if surface is not None:
-        regs.append(_common.register_field(viewer, V + 2 * step, mesh.F, "exact K", K, vrange, name="exact K",
-                                           cmap="coolwarm"))
+        regs.append(_common.register_field(viewer, V + 2 * step, mesh.F, "Gauss curvature K", K, vrange,
+                                           name="exact K", cmap="coolwarm", title=f"exact K — {faces}"))
     print(f"colour range of K (all copies): [{vrange[0]:.3g}, {vrange[1]:.3g}]")
     _common.finish(viewer, args, regs)
 
