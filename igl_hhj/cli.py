@@ -291,7 +291,7 @@ def _write(stages, args, mesh, est, S):
     from .mesh_io import write_curvature
     try:
         stages.run(f"writing {args.out}", write_curvature, args.out, mesh.V, mesh.F, est,
-                   method=args.method, S=S)
+                   method=args.method, S=S, quantity=args.quantity)
     except OSError as exc:
         raise UserError(f"{args.out}: cannot write: {exc.strerror or exc}") from None
     _say(args)(f"  wrote {args.out}")
@@ -385,11 +385,13 @@ def build_parser():
     c.add_argument("-o", "--out", metavar="OUT",
                    help="output file, by extension: OUT.npz (k1, k2, H, K, d1, d2, V, F, and the "
                         "shape operator S for hhj), OUT.csv (one row per vertex or face), OUT.ply "
-                        "(binary, the values as vertex or face properties)")
+                        "(the values as vertex or face properties, --quantity as MeshLab's quality), "
+                        "OUT.vtu / OUT.vtk (point or cell data for ParaView/pyvista; needs meshio), "
+                        "OUT.obj (vertices coloured by --quantity)")
     c.add_argument("--view", action="store_true", help="open the polyscope viewer")
     c.add_argument("--screenshot", metavar="PNG", help="render the curvature headless to PNG")
     c.add_argument("--quantity", choices=["k1", "k2", "H", "K"], default="H",
-                   help="what --view/--screenshot colour and the .ply 'quality' property hold: "
+                   help="what --view/--screenshot and .obj colours and the .ply 'quality' property show: "
                         "k1, k2 (principal curvatures), H (mean, default), K (Gauss)")
     c.add_argument("--camera", type=_camera, default="auto", metavar="DIR",
                    help="side the --view/--screenshot camera looks from: auto (largest projected "

@@ -21,8 +21,10 @@ with libigl's C++ messages captured, and raises :class:`MeshFileError` (a
 ``ValueError``) with one line naming the problem.
 
 :func:`write_curvature` writes a
-:class:`igl_hhj.baselines.CurvatureEstimate` as ``.npz``, ``.csv`` or
-binary little-endian ``.ply`` (numpy only, no per-element Python loops).
+:class:`igl_hhj.baselines.CurvatureEstimate` as ``.npz``, ``.csv``, ``.ply``
+(with MeshLab's ``quality``), ``.vtu`` / ``.vtk`` (through meshio, optional)
+or ``.obj`` with per-vertex colours, in forms that meshio, pyvista/VTK,
+pymeshlab/MeshLab and trimesh read (numpy only, no per-element Python loops).
 """
 from __future__ import annotations
 
@@ -34,12 +36,15 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["MeshFileError", "CapturedOutput", "MESH_EXTENSIONS", "OUTPUT_EXTENSIONS", "read_mesh",
-           "check_output_path", "probe_writable", "write_curvature", "CURVATURE_COLUMNS"]
+           "check_output_path", "probe_writable", "write_curvature", "CURVATURE_COLUMNS", "MESHIO_EXTENSIONS",
+           "quantity_colours"]
 
 MESH_EXTENSIONS = (".obj", ".off", ".ply", ".stl", ".wrl", ".mesh", ".msh")
 """Extensions ``igl.read_triangle_mesh`` dispatches on (case-insensitive)."""
 
-OUTPUT_EXTENSIONS = (".npz", ".csv", ".ply")
+OUTPUT_EXTENSIONS = (".npz", ".csv", ".ply", ".vtu", ".vtk", ".obj")
+MESHIO_EXTENSIONS = (".vtu", ".vtk")
+"""Output extensions written through meshio (an optional dependency)."""
 
 CURVATURE_COLUMNS = ("k1", "k2", "H", "K", "d1x", "d1y", "d1z", "d2x", "d2y", "d2z")
 """Per-element columns of the ``.csv`` and ``.ply`` outputs (after ``index`` in the csv)."""
@@ -299,8 +304,20 @@ def check_output_path(path):
     if ext not in OUTPUT_EXTENSIONS:
         raise MeshFileError(f"{path}: unknown output extension {path.suffix!r} "
                             f"(use {', '.join(OUTPUT_EXTENSIONS)})")
+    if ext in MESHIO_EXTENSIONS:
+        _meshio(path)
     probe_writable(path)
     return ext
+
+
+def _meshio(path):
+    """The meshio module, or a :class:`MeshFileError` saying how to install it."""
+    try:
+        import meshio
+    except ImportError:
+        raise MeshFileError(f"{path}: writing {Path(path).suffix} files needs meshio: "
+                            f"pip install meshio (or pip install \"igl-hhj[io]\")") from None
+    return meshio
 
 
 def probe_writable(path):
@@ -330,35 +347,105 @@ def _columns(est):
     return np.column_stack([est.k1, est.k2, est.H, est.K, d1, d2])
 
 
-def _write_ply(path, V, F, est):
-    vprops = [("x", "<f8"), ("y", "<f8"), ("z", "<f8")]
-    fprops = [("n", "u1"), ("vertex_indices", "<i4", (3,))]
-    cols = [(c, "<f8") for c in CURVATURE_COLUMNS]
-    data = _columns(est)
+QUANTITIES = ("k1", "k2", "H", "K")
+"""Values ``quantity=`` can put into PLY ``quality`` and OBJ colours."""
+
+
+def _ply_header(V, F, est, quantity, fmt):
+    # double like the rest: libigl 2.6's PLY reader aborts when one element's properties differ in type
+    extra = "".join(f"property double {c}\n" for c in CURVATURE_COLUMNS + ("quality",))
     per_vertex = est.location == "vertex"
-    vert = np.empty(len(V), dtype=vprops + (cols if per_vertex else []))
-    face = np.empty(len(F), dtype=fprops + ([] if per_vertex else cols))
+    return ("ply\n"
+            f"format {fmt} 1.0\n"
+            f"comment igl_hhj curvature, method {est.name}, per {est.location}; quality = {quantity}\n"
+            f"element vertex {len(V)}\nproperty double x\nproperty double y\nproperty double z\n"
+            + (extra if per_vertex else "")
+            + f"element face {len(F)}\nproperty list uchar int vertex_indices\n"
+            + ("" if per_vertex else extra) + "end_header\n")
+
+
+def _write_ply(path, V, F, est, quantity="H"):
+    """Binary little-endian PLY, the values as vertex or face properties plus ``quality``.
+
+    Binary also per face: libigl 2.6's ascii PLY reader aborts the process on face
+    properties (and meshio 5.3's binary reader cannot read them; use .vtu there)."""
+    cols = [(c, "<f8") for c in CURVATURE_COLUMNS + ("quality",)]
+    per_vertex = est.location == "vertex"
+    vert = np.empty(len(V), dtype=[("x", "<f8"), ("y", "<f8"), ("z", "<f8")] + (cols if per_vertex else []))
+    face = np.empty(len(F), dtype=[("n", "u1"), ("vertex_indices", "<i4", (3,))] + ([] if per_vertex else cols))
     vert["x"], vert["y"], vert["z"] = V.T
     face["n"] = 3
     face["vertex_indices"] = F
     target = vert if per_vertex else face
+    data = _columns(est)
     for j, c in enumerate(CURVATURE_COLUMNS):
         target[c] = data[:, j]
-    extra = "".join(f"property double {c}\n" for c in CURVATURE_COLUMNS)
-    header = ("ply\nformat binary_little_endian 1.0\n"
-              f"comment igl_hhj curvature, method {est.name}, per {est.location}\n"
-              f"element vertex {len(V)}\nproperty double x\nproperty double y\nproperty double z\n"
-              + (extra if per_vertex else "")
-              + f"element face {len(F)}\nproperty list uchar int vertex_indices\n"
-              + ("" if per_vertex else extra) + "end_header\n")
+    target["quality"] = getattr(est, quantity)
     with open(path, "wb") as fh:
-        fh.write(header.encode("ascii"))
+        fh.write(_ply_header(V, F, est, quantity, "binary_little_endian").encode("ascii"))
         fh.write(vert.tobytes())
         fh.write(face.tobytes())
 
 
-def write_curvature(path, V, F, est, *, method, S=None):
-    """Write curvatures per face or per vertex to ``.npz``, ``.csv`` or ``.ply``.
+def _fields(est):
+    """{name: (n,) or (n, 3) array}: k1, k2, H, K and the directions d1, d2 when present."""
+    out = {q: np.asarray(getattr(est, q), dtype=np.float64) for q in QUANTITIES}
+    if est.d1 is not None:
+        out.update(d1=np.asarray(est.d1, dtype=np.float64), d2=np.asarray(est.d2, dtype=np.float64))
+    return out
+
+
+def _write_meshio(path, V, F, est):
+    meshio = _meshio(path)
+    fields = _fields(est)
+    if est.location == "vertex":
+        mesh = meshio.Mesh(V, [("triangle", F)], point_data=fields)
+    else:
+        mesh = meshio.Mesh(V, [("triangle", F)], cell_data={k: [v] for k, v in fields.items()})
+    fmt = "vtk" if Path(path).suffix.lower() == ".vtk" else "vtu"
+    mesh.write(path, file_format=fmt, **({"binary": True} if fmt == "vtk" else {}))
+
+
+_DIVERGING = np.array([[0.230, 0.299, 0.754], [0.865, 0.865, 0.865], [0.706, 0.016, 0.150]])
+"""Blue, grey-white, red: the end and middle points of the coolwarm colour map."""
+
+
+def quantity_colours(values, robust=1.0):
+    """(n, 3) float RGB in [0, 1]: a diverging map symmetric about 0 (blue < 0 < red),
+    the range being the largest magnitude of the ``[robust, 100 - robust]``
+    percentiles; NaN values are grey."""
+    x = np.asarray(values, dtype=np.float64)
+    fin = x[np.isfinite(x)]
+    m = float(np.max(np.abs(np.percentile(fin, [robust, 100 - robust])))) if fin.size else 1.0
+    t = np.clip(np.nan_to_num(x, nan=0.0) / (m if m > 0 else 1.0), -1.0, 1.0)
+    lo, mid, hi = _DIVERGING
+    w = np.abs(t)[:, None]
+    rgb = np.where((t < 0)[:, None], mid + w * (lo - mid), mid + w * (hi - mid))
+    rgb[~np.isfinite(x)] = 0.5
+    return rgb
+
+
+def _write_obj(path, V, F, est, quantity="H"):
+    """Wavefront OBJ with ``v x y z r g b`` lines (the colour extension MeshLab,
+    trimesh, Blender read); per-face values are area-averaged to the vertices."""
+    import igl
+    values = np.asarray(getattr(est, quantity), dtype=np.float64)
+    if est.location == "face":
+        area = 0.5 * np.asarray(igl.doublearea(V, F)).ravel()
+        w = np.where(np.isfinite(values), area, 0.0)
+        num = np.bincount(F.ravel(), weights=np.repeat(np.nan_to_num(values) * w, 3), minlength=len(V))
+        den = np.bincount(F.ravel(), weights=np.repeat(w, 3), minlength=len(V))
+        values = np.full(len(V), np.nan)
+        np.divide(num, den, out=values, where=den > 0)
+    with open(path, "w") as fh:
+        fh.write(f"# igl_hhj curvature, method {est.name}, per {est.location}; vertex colours: {quantity} "
+                 f"(coolwarm, symmetric about 0)\n")
+        np.savetxt(fh, np.column_stack([V, quantity_colours(values)]), fmt="v %.17g %.17g %.17g %.4f %.4f %.4f")
+        np.savetxt(fh, F + 1, fmt="f %d %d %d")
+
+
+def write_curvature(path, V, F, est, *, method, S=None, quantity="H"):
+    """Write curvatures per face or per vertex to ``.npz``, ``.csv``, ``.ply``, ``.vtu``, ``.vtk`` or ``.obj``.
 
     Parameters
     ----------
@@ -370,6 +457,8 @@ def write_curvature(path, V, F, est, *, method, S=None):
         The method name stored in the file (``hhj``, ``igl``, ``heine``).
     S : (#F, 3, 3) float64, optional
         The HHJ shape operator, stored in the ``.npz`` only.
+    quantity : {"k1", "k2", "H", "K"}
+        What the ``.ply`` ``quality`` property and the ``.obj`` colours hold.
 
     Files
     -----
@@ -377,10 +466,26 @@ def write_curvature(path, V, F, est, *, method, S=None):
     ``per`` and ``method`` (0-d strings), ``S`` when given.
     ``.csv``: header ``index,k1,k2,H,K,d1x,d1y,d1z,d2x,d2y,d2z``, one row per
     element, full float64 precision.
-    ``.ply``: binary little-endian; ``vertex`` x, y, z and ``face``
-    vertex_indices (uchar count, int indices); the columns of the csv as
-    ``double`` properties of the vertices or of the faces.
+    ``.ply``: ``vertex`` x, y, z and ``face`` vertex_indices (uchar count, int
+    indices); the columns of the csv as ``double`` properties of the vertices
+    or of the faces, and ``quantity`` again as ``double quality`` (what MeshLab
+    colours by); binary little-endian.  Read by libigl, pymeshlab/MeshLab,
+    trimesh; meshio 5.3 reads the per-vertex file but not binary face
+    properties (write ``.vtu`` for meshio/pyvista per face).
+    ``.vtu`` / ``.vtk`` (needs meshio): k1, k2, H, K and the vectors d1, d2 as
+    point data (per vertex) or cell data (per face) — ParaView, pyvista.
+    ``.obj``: vertices coloured by ``quantity`` (``v x y z r g b``, a
+    diverging map symmetric about 0 over the 1st-99th percentile magnitude;
+    per-face values area-averaged to the vertices): a quick look, no values.
+
+    Examples
+    --------
+    >>> from igl_hhj import baselines, mesh_io                  # doctest: +SKIP
+    >>> est = baselines.hhj_vertex(V, F)                         # doctest: +SKIP
+    >>> mesh_io.write_curvature("bunny_H.ply", V, F, est, method="hhj")   # doctest: +SKIP
     """
+    if quantity not in QUANTITIES:
+        raise ValueError(f"quantity must be one of {QUANTITIES}, got {quantity!r}")
     ext = Path(path).suffix.lower()
     if ext == ".npz":
         arrays = dict(k1=est.k1, k2=est.k2, H=est.H, K=est.K, V=V, F=F,
@@ -396,6 +501,10 @@ def write_curvature(path, V, F, est, *, method, S=None):
         np.savetxt(path, table, delimiter=",", fmt=["%d"] + ["%.17g"] * data.shape[1],
                    header=",".join(("index",) + CURVATURE_COLUMNS), comments="")
     elif ext == ".ply":
-        _write_ply(path, V, F, est)
+        _write_ply(path, V, F, est, quantity)
+    elif ext in MESHIO_EXTENSIONS:
+        _write_meshio(path, V, F, est)
+    elif ext == ".obj":
+        _write_obj(path, V, F, est, quantity)
     else:
         raise MeshFileError(f"{path}: unknown output extension (use {', '.join(OUTPUT_EXTENSIONS)})")

@@ -173,8 +173,9 @@ def test_curvature_outputs_agree_and_reread(sphere, tmp_path, capsys, per):
     table = ply[per]
     for j, c in enumerate(COLUMNS):
         np.testing.assert_array_equal(table[c], csv[:, 1 + j])
+    np.testing.assert_array_equal(table["quality"], d["H"])             # MeshLab's quality = H (--quantity)
     other = "face" if per == "vertex" else "vertex"
-    assert "k1" not in ply[other].dtype.names
+    assert "k1" not in ply[other].dtype.names and "quality" not in ply[other].dtype.names
 
 
 @pytest.mark.parametrize("method, fn", [("igl", baselines.libigl_quadric), ("heine", baselines.heine)])
