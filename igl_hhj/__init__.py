@@ -14,6 +14,8 @@ biharmonic solver, also as :func:`biharmonic_solve`), :mod:`igl_hhj.baselines`
 :mod:`igl_hhj.viewer` (polyscope viewers and headless screenshots),
 :mod:`igl_hhj.mesh_io` (guarded mesh reading, curvature output files),
 :mod:`igl_hhj.mesh_report` (what a mesh is made of and whether igl_hhj accepts it),
+:mod:`igl_hhj.interop` (trimesh / pyvista / meshio mesh objects in, results back onto them),
+:mod:`igl_hhj.demos` (the demos, ``igl-hhj demo NAME``),
 :mod:`igl_hhj.surfaces` (exact test surfaces and mesh sequences), :mod:`igl_hhj.benchmarks`,
 :mod:`igl_hhj.cli` (the ``igl-hhj`` command).
 """
@@ -34,7 +36,7 @@ from .mesh import TriangleMesh, validate_mesh
 __version__ = "0.1.0"
 
 _LAZY_MODULES = {"regge", "biharmonic", "baselines", "viewer", "surfaces", "benchmarks",
-                 "hhj", "mesh", "convergence", "cli", "mesh_io", "mesh_report"}
+                 "hhj", "mesh", "convergence", "cli", "mesh_io", "mesh_report", "interop", "demos"}
 _LAZY_ATTRS = {"biharmonic_solve": "biharmonic", "BiharmonicSolver": "biharmonic"}
 
 __all__ = [

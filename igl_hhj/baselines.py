@@ -126,7 +126,7 @@ def _given_shape_operator(mesh, S, kwargs):
     return S
 
 
-def hhj_vertex(V, F, *, shape_operator=None, **kwargs):
+def hhj_vertex(V, F=None, *, shape_operator=None, **kwargs):
     """HHJ drop-in at the vertices (:func:`igl_hhj.curvature.principal_curvature`).
 
     Parameters
@@ -149,7 +149,7 @@ def hhj_vertex(V, F, *, shape_operator=None, **kwargs):
     return _ordered("hhj_vertex", "vertex", PV1, PV2, 0.5 * (PV1 + PV2), PV1 * PV2, PD1, PD2, bad)
 
 
-def hhj_face(V, F, *, shape_operator=None, **kwargs):
+def hhj_face(V, F=None, *, shape_operator=None, **kwargs):
     """Walker's HHJ shape operator S_h per face (eq. 5.12/5.14).
 
     Parameters

@@ -119,7 +119,7 @@ def _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supp
 
 
 # --------------------------------------------------------------------------- public API
-def shape_operator(V, F, *, boundary_normals=None, boundary_shape_operator=None,
+def shape_operator(V, F=None, *, boundary_normals=None, boundary_shape_operator=None,
                    simply_supported=None, solver="auto"):
     """Walker's HHJ approximation S_h of the shape operator ∇_Γν, one tensor per face.
 
@@ -242,7 +242,7 @@ def principal_from_shape_operator(S, normals):
     return PD1, PD2, PV1, PV2
 
 
-def face_principal_curvature(V, F, **boundary):
+def face_principal_curvature(V, F=None, **boundary):
     """Per-face principal curvatures and directions from the HHJ shape operator.
 
     Keyword arguments are those of :func:`shape_operator`.
@@ -258,13 +258,13 @@ def face_principal_curvature(V, F, **boundary):
     return principal_from_shape_operator(S, mesh.face_normals)
 
 
-def face_mean_curvature(V, F, **boundary):
+def face_mean_curvature(V, F=None, **boundary):
     """Per-face mean curvature H = (κ1 + κ2)/2 = tr(S_h)/2 (Walker's κ^a / 2), shape (#F,)."""
     S = shape_operator(V, F, **boundary)
     return 0.5 * np.trace(S, axis1=1, axis2=2)
 
 
-def face_gaussian_curvature(V, F, **boundary):
+def face_gaussian_curvature(V, F=None, **boundary):
     """Per-face Gauss curvature K = κ1 κ2 = det(S_h + ν_T ⊗ ν_T) (Walker eq. 6.1), shape (#F,)."""
     mesh = as_mesh(V, F)
     S = shape_operator(mesh, None, **boundary)
@@ -328,7 +328,7 @@ def vertex_shape_operator(mesh, S):
     return Sv, N
 
 
-def principal_curvature(V, F, radius=5, useKring=True, *, boundary_normals=None,
+def principal_curvature(V, F=None, radius=5, useKring=True, *, boundary_normals=None,
                         boundary_shape_operator=None, simply_supported=None, solver="auto"):
     """Drop-in replacement for ``igl.principal_curvature`` (libigl ≥ 2.5.4 / 2.6).
 

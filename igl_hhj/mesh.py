@@ -373,11 +373,21 @@ class TriangleMesh:
 
 
 def as_mesh(V, F=None):
-    """Return a :class:`TriangleMesh` for ``(V, F)``; a ``TriangleMesh`` passes through."""
+    """Return a :class:`TriangleMesh` for ``(V, F)``; a ``TriangleMesh`` passes through.
+
+    With ``F`` None, ``V`` may also be a mesh object of another library
+    (``trimesh.Trimesh``, triangulated ``pyvista.PolyData``, ``meshio.Mesh``;
+    duck-typed by :func:`igl_hhj.interop.mesh_arrays`).
+    """
     if isinstance(V, TriangleMesh) and F is None:
         return V
     if F is None:
-        raise TypeError("F is required unless V is a TriangleMesh")
+        from .interop import mesh_arrays
+        arrays = mesh_arrays(V)
+        if arrays is None:
+            raise TypeError("F is required unless V is a TriangleMesh or a mesh object "
+                            "(trimesh.Trimesh, pyvista.PolyData, meshio.Mesh)")
+        return TriangleMesh(*arrays)
     return TriangleMesh(V, F)
 
 

@@ -302,7 +302,7 @@ def local_edge_length(mesh, location):
     return out
 
 
-def curvature_estimate(V, F, *, method="hhj", per="face", **kwargs):
+def curvature_estimate(V, F=None, *, method="hhj", per="face", **kwargs):
     """Curvatures of one estimator as a :class:`igl_hhj.baselines.CurvatureEstimate`.
 
     Parameters
@@ -319,6 +319,9 @@ def curvature_estimate(V, F, *, method="hhj", per="face", **kwargs):
     from . import baselines
     _check(method, "method", METHODS)
     _check(per, "per", ("face", "vertex"))
+    if F is None:                       # a mesh object (trimesh, pyvista, meshio) or a TriangleMesh
+        mesh = as_mesh(V)
+        V, F = mesh.V, mesh.F
     if method == "hhj":
         return (baselines.hhj_face if per == "face" else baselines.hhj_vertex)(V, F, **kwargs)
     if per == "face":
@@ -574,7 +577,7 @@ def _finish(reg, screenshot, size):
 
 
 # --------------------------------------------------------------------------- curvature
-def register_curvature(V, F, estimate=None, *, method="hhj", per="both", name="mesh", enabled="H",
+def register_curvature(V, F=None, estimate=None, *, method="hhj", per="both", name="mesh", enabled="H",
                        directions=True, show_directions=False, symmetric=True, robust=None, cmap="coolwarm", ranges=None,
                        direction_scale=0.5, offset=None, view=None, title=None, screenshot=None, size=(1024, 768),
                        **estimator_kwargs):
@@ -665,7 +668,7 @@ def _check_sizes(mesh, ests):
                              f"the mesh has {n} {e.location}s")
 
 
-def register_comparison(V, F, *, hhj=None, libigl=None, per="face", layout="copy", name="mesh", enabled="H",
+def register_comparison(V, F=None, *, hhj=None, libigl=None, per="face", layout="copy", name="mesh", enabled="H",
                         directions=True, show_directions=False, symmetric=True, robust=None, cmap="coolwarm", offset=None,
                         direction_scale=0.5, radius=5, view=None, title=None, screenshot=None, size=(1600, 800)):
     """HHJ curvature beside ``igl.principal_curvature`` on the same mesh, identical colour ranges.
@@ -864,7 +867,7 @@ def register_biharmonic(V, F, u1, u2=None, *, exact=None, f=None, name="mesh", e
     return _finish(reg, screenshot, size)
 
 
-def register_regge_curvature(V, F, *, boundary="natural", mass="consistent", compare=True, name="mesh",
+def register_regge_curvature(V, F=None, *, boundary="natural", mass="consistent", compare=True, name="mesh",
                              enabled="K_h", symmetric=True, robust=None, cmap="coolwarm", vminmax=None,
                              offset=None, view=None, title=None, screenshot=None, size=(1024, 768)):
     """Register the Regge (degree-0, edge-length metric) Gauss curvature K_h (Gopalakrishnan et al. 2024).

@@ -207,7 +207,7 @@ def gauss_curvature_intrinsic(l_sq, F, *, boundary="natural", mass="consistent")
     return _lift(Lf, F, nV, uE, count, boundary, mass)
 
 
-def gauss_curvature(V, F, *, boundary="natural", mass="consistent"):
+def gauss_curvature(V, F=None, *, boundary="natural", mass="consistent"):
     """P1 lifting of the distributional Gauss curvature of the edge-length
     (degree-0 Regge) metric of an embedded mesh.
 
