@@ -7,7 +7,10 @@ operator ``P / R`` and principal curvatures ``+1/R``.
 """
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from .hhj import HHJProjection, clamped_load, face_tensors
 from .mesh import TriangleMesh, as_mesh, per_vertex_array
@@ -119,8 +122,9 @@ def _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supp
 
 
 # --------------------------------------------------------------------------- public API
-def shape_operator(V, F=None, *, boundary_normals=None, boundary_shape_operator=None,
-                   simply_supported=None, solver="auto"):
+def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary_normals: ArrayLike | None = None,
+                   boundary_shape_operator: ArrayLike | None = None, simply_supported: ArrayLike | None = None,
+                   solver: str = "auto") -> NDArray[np.float64]:
     """Walker's HHJ approximation S_h of the shape operator ∇_Γν, one tensor per face.
 
     Solves ``A s^k = -B X^k + g^k`` for the three coordinate functions
@@ -161,12 +165,23 @@ def shape_operator(V, F=None, *, boundary_normals=None, boundary_shape_operator=
     its rate near the boundary drops to about O(h^1/2).  Triangles with all
     three vertices on the boundary (excluded by Walker's Property 1) are
     allowed: A stays SPD; their values are least accurate.
+    Examples
+    --------
+    >>> import numpy as np, igl_hhj
+    >>> from igl_hhj.surfaces import icosphere
+    >>> V, F = icosphere(3)                       # unit sphere, outward normals
+    >>> S = igl_hhj.shape_operator(V, F)
+    >>> S.shape
+    (1280, 3, 3)
+    >>> round(float(np.median(np.trace(S, axis1=1, axis2=2))), 2)   # κ1 + κ2 = 2/R
+    2.0
     """
     mesh = as_mesh(V, F)
     return _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver)
 
 
-def surface_hessian(V, F, w, *, boundary_gradient=None, solver="auto"):
+def surface_hessian(V: Any, F: ArrayLike | None, w: ArrayLike, *, boundary_gradient: ArrayLike | None = None,
+                    solver: str = "auto") -> NDArray[np.float64]:
     """HHJ projection of the surface Hessian ∇_Γ∇_Γ w of a P1 function (Walker eq. 4.9).
 
     Parameters
@@ -182,6 +197,13 @@ def surface_hessian(V, F, w, *, boundary_gradient=None, solver="auto"):
     Returns
     -------
     H : (#F, 3, 3) (or (#F, k, 3, 3)) float64, symmetric tangential tensors.
+    Examples
+    --------
+    >>> import igl_hhj
+    >>> from igl_hhj.surfaces import icosphere
+    >>> V, F = icosphere(3)
+    >>> igl_hhj.surface_hessian(V, F, V[:, 2] ** 2).shape   # (#F, 3, 3), one tensor per face
+    (1280, 3, 3)
     """
     mesh = as_mesh(V, F)
     w_arr = np.asarray(w)
@@ -211,7 +233,8 @@ def surface_hessian(V, F, w, *, boundary_gradient=None, solver="auto"):
     return H[:, 0] if single else H
 
 
-def principal_from_shape_operator(S, normals):
+def principal_from_shape_operator(S: NDArray[np.floating], normals: NDArray[np.floating]
+                                  ) -> tuple[NDArray[np.float64], ...]:
     """Principal curvatures and directions of tangential tensors.
 
     Parameters
@@ -242,7 +265,7 @@ def principal_from_shape_operator(S, normals):
     return PD1, PD2, PV1, PV2
 
 
-def face_principal_curvature(V, F=None, **boundary):
+def face_principal_curvature(V: Any, F: ArrayLike | None = None, **boundary: Any) -> tuple[NDArray[np.float64], ...]:
     """Per-face principal curvatures and directions from the HHJ shape operator.
 
     Keyword arguments are those of :func:`shape_operator`.
@@ -252,19 +275,26 @@ def face_principal_curvature(V, F=None, **boundary):
     PD1, PD2 : (#F, 3) unit directions of maximal / minimal curvature in the
         face plane (PD2 = ν_T × PD1).
     PV1, PV2 : (#F,) principal curvatures κ1 ≥ κ2.
+    Examples
+    --------
+    >>> import igl_hhj
+    >>> from igl_hhj.surfaces import icosphere
+    >>> PD1, PD2, PV1, PV2 = igl_hhj.face_principal_curvature(*icosphere(3))
+    >>> PD1.shape, PV1.shape
+    ((1280, 3), (1280,))
     """
     mesh = as_mesh(V, F)
     S = shape_operator(mesh, None, **boundary)   # the validated mesh passes through as_mesh
     return principal_from_shape_operator(S, mesh.face_normals)
 
 
-def face_mean_curvature(V, F=None, **boundary):
+def face_mean_curvature(V: Any, F: ArrayLike | None = None, **boundary: Any) -> NDArray[np.float64]:
     """Per-face mean curvature H = (κ1 + κ2)/2 = tr(S_h)/2 (Walker's κ^a / 2), shape (#F,)."""
     S = shape_operator(V, F, **boundary)
     return 0.5 * np.trace(S, axis1=1, axis2=2)
 
 
-def face_gaussian_curvature(V, F=None, **boundary):
+def face_gaussian_curvature(V: Any, F: ArrayLike | None = None, **boundary: Any) -> NDArray[np.float64]:
     """Per-face Gauss curvature K = κ1 κ2 = det(S_h + ν_T ⊗ ν_T) (Walker eq. 6.1), shape (#F,)."""
     mesh = as_mesh(V, F)
     S = shape_operator(mesh, None, **boundary)
@@ -328,8 +358,11 @@ def vertex_shape_operator(mesh, S):
     return Sv, N
 
 
-def principal_curvature(V, F=None, radius=5, useKring=True, *, boundary_normals=None,
-                        boundary_shape_operator=None, simply_supported=None, solver="auto"):
+def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, useKring: bool = True, *,
+                        boundary_normals: ArrayLike | None = None, boundary_shape_operator: ArrayLike | None = None,
+                        simply_supported: ArrayLike | None = None, solver: str = "auto"
+                        ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
+                                   list[int]]:
     """Drop-in replacement for ``igl.principal_curvature`` (libigl ≥ 2.5.4 / 2.6).
 
     Same call forms, same return tuple, shapes, dtypes, ordering and sign, but
@@ -363,6 +396,16 @@ def principal_curvature(V, F=None, radius=5, useKring=True, *, boundary_normals=
         Empty for a mesh without unreferenced vertices.
 
     Positive curvature on a sphere with outward normals, as libigl.
+    Examples
+    --------
+    >>> import numpy as np, igl_hhj
+    >>> from igl_hhj.surfaces import icosphere
+    >>> V, F = icosphere(3)
+    >>> PD1, PD2, PV1, PV2, bad = igl_hhj.principal_curvature(V, F)   # as igl.principal_curvature(V, F)
+    >>> PV1.shape, bad
+    ((642,), [])
+    >>> round(float(np.median(PV1)), 2)         # +1/R on a sphere with outward normals
+    1.0
     """
     check_principal_curvature_args(radius, useKring)
     mesh = as_mesh(V, F)

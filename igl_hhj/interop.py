@@ -148,7 +148,7 @@ def _validated(V, F, results):
     return mesh.V, mesh.F, results
 
 
-def to_trimesh(V: Any, F: Any = None, results: Any = None):
+def to_trimesh(V: Any, F: Any = None, results: Any = None) -> Any:
     """A ``trimesh.Trimesh`` (``process=False``: vertex order kept) with the results
     as ``vertex_attributes`` / ``face_attributes``.
 
@@ -163,7 +163,7 @@ def to_trimesh(V: Any, F: Any = None, results: Any = None):
     return trimesh.Trimesh(V, F, process=False, vertex_attributes=pv_, face_attributes=pf)
 
 
-def to_pyvista(V: Any, F: Any = None, results: Any = None):
+def to_pyvista(V: Any, F: Any = None, results: Any = None) -> Any:
     """A ``pyvista.PolyData`` with the results as ``point_data`` / ``cell_data``."""
     import pyvista
     V, F, results = _validated(V, F, results)
@@ -176,7 +176,7 @@ def to_pyvista(V: Any, F: Any = None, results: Any = None):
     return out
 
 
-def to_meshio(V: Any, F: Any = None, results: Any = None):
+def to_meshio(V: Any, F: Any = None, results: Any = None) -> Any:
     """A ``meshio.Mesh`` (one triangle block) with the results as ``point_data`` /
     ``cell_data`` (``mesh.write("x.vtu")`` for ParaView)."""
     import meshio

@@ -33,6 +33,8 @@ import re
 import tempfile
 from pathlib import Path
 
+from typing import Any
+
 import numpy as np
 
 __all__ = ["MeshFileError", "CapturedOutput", "MESH_EXTENSIONS", "OUTPUT_EXTENSIONS", "read_mesh",
@@ -293,7 +295,7 @@ def read_mesh(path):
 
 
 # --------------------------------------------------------------------------- writing
-def check_output_path(path):
+def check_output_path(path: str | os.PathLike) -> str:
     """Check before any computation that ``path`` has a known extension and can be written.
 
     Opens the file for appending (so an existing file is not truncated) and
@@ -410,7 +412,7 @@ _DIVERGING = np.array([[0.230, 0.299, 0.754], [0.865, 0.865, 0.865], [0.706, 0.0
 """Blue, grey-white, red: the end and middle points of the coolwarm colour map."""
 
 
-def quantity_colours(values, robust=1.0):
+def quantity_colours(values: Any, robust: float = 1.0) -> np.ndarray:
     """(n, 3) float RGB in [0, 1]: a diverging map symmetric about 0 (blue < 0 < red),
     the range being the largest magnitude of the ``[robust, 100 - robust]``
     percentiles; NaN values are grey."""
@@ -444,7 +446,8 @@ def _write_obj(path, V, F, est, quantity="H"):
         np.savetxt(fh, F + 1, fmt="f %d %d %d")
 
 
-def write_curvature(path, V, F, est, *, method, S=None, quantity="H"):
+def write_curvature(path: str | os.PathLike, V: np.ndarray, F: np.ndarray, est: Any, *, method: str,
+                    S: np.ndarray | None = None, quantity: str = "H") -> None:
     """Write curvatures per face or per vertex to ``.npz``, ``.csv``, ``.ply``, ``.vtu``, ``.vtk`` or ``.obj``.
 
     Parameters

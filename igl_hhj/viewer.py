@@ -46,6 +46,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -72,7 +73,7 @@ METHOD_TITLES = {"HHJ": "HHJ", "libigl": "libigl quadric fit", "Heine": "Heine P
 _TAG = {"hhj": "HHJ", "igl": "libigl", "heine": "Heine"}
 _EGL_HINT = ("headless rendering needs EGL: on Debian/Ubuntu `apt-get install libegl1 libegl-mesa0 "
              "libgl1-mesa-dri`")
-_REGISTERED = {}  # name -> (2, 3) bounds of the structures this module registered (they may since be removed)
+_REGISTERED: dict[str, np.ndarray] = {}  # name -> (2, 3) bounds of the structures this module registered (they may since be removed)
 
 
 class ViewerUnavailable(RuntimeError):
@@ -147,7 +148,7 @@ def _backend_name(ps):
         return ""
 
 
-def init(backend="auto"):
+def init(backend="auto") -> Any:
     """Initialise polyscope and return the ``polyscope`` module.
 
     Parameters
@@ -205,7 +206,7 @@ PANEL_PX = 320
 """Width of polyscope's left-hand panel at UI scale 1 (its 305 px plus a gap)."""
 
 
-def show(*, window=(1600, 900), layout=True):
+def show(*, window=(1600, 900), layout=True) -> None:
     """Open polyscope's interactive window on everything registered (needs a display).
 
     Parameters
@@ -244,7 +245,7 @@ def _window_layout(ps, window):
 
 
 # --------------------------------------------------------------------------- values
-def color_range(*arrays, symmetric=True, robust=None):
+def color_range(*arrays, symmetric=True, robust=None) -> tuple[float, float]:
     """One colour range for several value arrays (NaN/inf ignored).
 
     Parameters
@@ -280,7 +281,7 @@ def color_range(*arrays, symmetric=True, robust=None):
     return lo, hi
 
 
-def local_edge_length(mesh, location):
+def local_edge_length(mesh, location) -> np.ndarray:
     """Mean length of the edges of each face, or incident to each vertex.
 
     Parameters
@@ -302,7 +303,7 @@ def local_edge_length(mesh, location):
     return out
 
 
-def curvature_estimate(V, F=None, *, method="hhj", per="face", **kwargs):
+def curvature_estimate(V: Any, F: Any = None, *, method="hhj", per="face", **kwargs) -> Any:
     """Curvatures of one estimator as a :class:`igl_hhj.baselines.CurvatureEstimate`.
 
     Parameters
@@ -354,7 +355,7 @@ def _fibonacci_sphere(n):
     return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
 
 
-def best_view_direction(V, F, *, n_directions=400, max_faces=50_000):
+def best_view_direction(V, F, *, n_directions=400, max_faces=50_000) -> np.ndarray:
     """Unit direction from which the mesh shows its largest projected area.
 
     The projected area seen from ``d`` is ``½ Σ_T |T| |n_T · d|`` (closed
@@ -400,7 +401,7 @@ def best_view_direction(V, F, *, n_directions=400, max_faces=50_000):
     return d / np.linalg.norm(d)
 
 
-def view_rotation(view, V=None, F=None, *, landscape=False):
+def view_rotation(view, V=None, F=None, *, landscape=False) -> np.ndarray:
     """(3, 3) rotation ``R``: ``V @ R.T`` is seen from ``view`` by the screenshots' camera
     (which looks down -z with y up).
 
@@ -577,10 +578,10 @@ def _finish(reg, screenshot, size):
 
 
 # --------------------------------------------------------------------------- curvature
-def register_curvature(V, F=None, estimate=None, *, method="hhj", per="both", name="mesh", enabled="H",
+def register_curvature(V: Any, F: Any = None, estimate=None, *, method="hhj", per="both", name="mesh", enabled="H",
                        directions=True, show_directions=False, symmetric=True, robust=None, cmap="coolwarm", ranges=None,
                        direction_scale=0.5, offset=None, view=None, title=None, screenshot=None, size=(1024, 768),
-                       **estimator_kwargs):
+                       **estimator_kwargs) -> Registration:
     """Register a mesh with its curvature: κ1, κ2, H, K (scalars) and principal directions.
 
     Parameters
@@ -616,6 +617,16 @@ def register_curvature(V, F=None, estimate=None, *, method="hhj", per="both", na
     Returns
     -------
     Registration (``ranges`` has keys "k1", "k2", "H", "K").
+
+    Examples
+    --------
+    >>> from igl_hhj import viewer
+    >>> from igl_hhj.surfaces import icosphere
+    >>> V, F = icosphere(3)
+    >>> reg = viewer.register_curvature(V, F, per="face", enabled="H", robust=2,
+    ...                                 screenshot="sphere_H.png", size=(800, 600))   # doctest: +SKIP
+    >>> reg.titles                                                                   # doctest: +SKIP
+    {'mesh': 'HHJ, per face — 1,280 faces'}
     """
     if enabled is not None:
         _check(enabled, "enabled", QUANTITIES)
@@ -668,9 +679,9 @@ def _check_sizes(mesh, ests):
                              f"the mesh has {n} {e.location}s")
 
 
-def register_comparison(V, F=None, *, hhj=None, libigl=None, per="face", layout="copy", name="mesh", enabled="H",
+def register_comparison(V: Any, F: Any = None, *, hhj=None, libigl=None, per="face", layout="copy", name="mesh", enabled="H",
                         directions=True, show_directions=False, symmetric=True, robust=None, cmap="coolwarm", offset=None,
-                        direction_scale=0.5, radius=5, view=None, title=None, screenshot=None, size=(1600, 800)):
+                        direction_scale=0.5, radius=5, view=None, title=None, screenshot=None, size=(1600, 800)) -> Registration:
     """HHJ curvature beside ``igl.principal_curvature`` on the same mesh, identical colour ranges.
 
     Parameters
@@ -694,6 +705,15 @@ def register_comparison(V, F=None, *, hhj=None, libigl=None, per="face", layout=
     Returns
     -------
     Registration; ``ranges[q]`` is the one range used by both estimators.
+
+    Examples
+    --------
+    >>> from igl_hhj import viewer
+    >>> from igl_hhj.surfaces import icosphere
+    >>> V, F = icosphere(3)
+    >>> reg = viewer.register_comparison(V, F, enabled="K", view="auto",
+    ...                                  screenshot="sphere_K.png")        # doctest: +SKIP
+    >>> viewer.register_comparison(V, F); viewer.show()                    # doctest: +SKIP
     """
     if enabled is not None:
         _check(enabled, "enabled", QUANTITIES)
@@ -734,7 +754,7 @@ def register_comparison(V, F=None, *, hhj=None, libigl=None, per="face", layout=
 # --------------------------------------------------------------------------- other fields
 def register_hessian(V, F, w, *, boundary_gradient=None, name="mesh", label="w", enabled="trace",
                      directions=True, symmetric=True, robust=None, cmap="coolwarm", direction_scale=0.5,
-                     offset=None, view=None, title=None, screenshot=None, size=(1024, 768)):
+                     offset=None, view=None, title=None, screenshot=None, size=(1024, 768)) -> Registration:
     """Register a P1 function ``w`` and its HHJ surface Hessian (Walker eq. 4.9).
 
     Parameters
@@ -802,7 +822,7 @@ _BIHARMONIC_LABELS = {"u1": "u1 (approx. u)", "u2": "u2 (approx. -Laplacian u)",
 
 def register_biharmonic(V, F, u1, u2=None, *, exact=None, f=None, name="mesh", enabled="u1", symmetric=None,
                         robust=None, ranges=None, offset=None, view=None, title=None, screenshot=None,
-                        size=(1024, 768)):
+                        size=(1024, 768)) -> Registration:
     """Register a mixed-P1 biharmonic solution (Stein et al.): ``u1 ≈ u``, ``u2 ≈ -Δu``.
 
     Parameters
@@ -867,9 +887,9 @@ def register_biharmonic(V, F, u1, u2=None, *, exact=None, f=None, name="mesh", e
     return _finish(reg, screenshot, size)
 
 
-def register_regge_curvature(V, F=None, *, boundary="natural", mass="consistent", compare=True, name="mesh",
+def register_regge_curvature(V: Any, F: Any = None, *, boundary="natural", mass="consistent", compare=True, name="mesh",
                              enabled="K_h", symmetric=True, robust=None, cmap="coolwarm", vminmax=None,
-                             offset=None, view=None, title=None, screenshot=None, size=(1024, 768)):
+                             offset=None, view=None, title=None, screenshot=None, size=(1024, 768)) -> Registration:
     """Register the Regge (degree-0, edge-length metric) Gauss curvature K_h (Gopalakrishnan et al. 2024).
 
     Parameters
@@ -925,7 +945,7 @@ def register_regge_curvature(V, F=None, *, boundary="natural", mass="consistent"
 
 def register_scalars(V, F, fields, *, name="mesh", enabled=None, shared_range=False, symmetric=True, robust=None,
                      cmap="coolwarm", vminmax=None, offset=None, view=None, title=None, screenshot=None,
-                     size=(1024, 768)):
+                     size=(1024, 768)) -> Registration:
     """Register arbitrary per-vertex / per-face scalar fields (errors, indicators, ...).
 
     Parameters
@@ -977,7 +997,7 @@ def register_scalars(V, F, fields, *, name="mesh", enabled=None, shared_range=Fa
     return _finish(reg, screenshot, size)
 
 
-def merge(*registrations):
+def merge(*registrations) -> Registration:
     """One :class:`Registration` holding several (e.g. to screenshot them together)."""
     out = Registration()
     for r in registrations:
@@ -1195,7 +1215,7 @@ def _frame(ps, bounds, width, height, margin=0.04, top_px=0, left_px=0):
     return (float(target[0]), float(target[1])), wpp
 
 
-def screenshot(path, registration=None, *, size=(1024, 768), annotate=True):
+def screenshot(path, registration=None, *, size=(1024, 768), annotate=True) -> str:
     """Render headless (EGL, unless an interactive backend is running) and save a PNG.
 
     Parameters

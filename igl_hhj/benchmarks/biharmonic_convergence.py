@@ -131,18 +131,14 @@ def _plot(results, path):
     import matplotlib.ticker
     names = list(results)
     fig, axes = plt.subplots(2, (len(names) + 1) // 2, figsize=(4.2 * ((len(names) + 1) // 2), 7.5))
+    from ..convergence import plot_convergence
     for ax, name in zip(axes.ravel(), names):
         rows = results[name]
         h = np.array([r["h"] for r in rows])
-        for k, lab in KEYS:
-            ax.loglog(h, [r[k] for r in rows], "o-", ms=3, label=lab)
-        for p, ls in ((1, ":"), (2, "--")):
-            ax.loglog(h, rows[-1]["u1_L2"] * (h / h[-1]) ** p, "k" + ls, lw=0.8, label=f"h^{p}")
-        ax.set_title(name, fontsize=10)
-        ax.set_xlabel("h (longest edge)")
+        plot_convergence(h, [[r[k] for r in rows] for k, _ in KEYS], [lab for _, lab in KEYS], ax=ax,
+                         rates=(1, 2), title=name, legend=False, styles=[{"ms": 3}] * len(KEYS))
         ax.invert_xaxis()
         ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
-        ax.grid(True, which="both", lw=0.3)
     for ax in axes.ravel()[len(names):]:
         ax.axis("off")
     axes.ravel()[0].legend(fontsize=7)

@@ -323,6 +323,8 @@ def _plots(acc, outdir):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
+    from ..convergence import plot_convergence
     files = []
     for cname, c in acc.items():
         if not c["levels"]:
@@ -331,16 +333,12 @@ def _plots(acc, outdir):
         for ax, q, title in zip(axes, ("H", "K", "k1", "dir"),
                                 ("rel. L2 error of H", "rel. L2 error of K", "rel. L2 error of κ1",
                                  "RMS angle of κ1 direction (deg)")):
-            for name, runs in c["runs"].items():
-                hs = [r["h"] for r in runs if q in r]
-                es = [r[q] for r in runs if q in r]
-                if len(es) >= 2 and np.all(np.isfinite(es)):
-                    ax.loglog(hs, es, "o-", label=name, ms=4)
-            h = np.array([lv["h"] for lv in c["levels"]])
-            ax.loglog(h, 0.5 * h / h[0] * ax.get_ylim()[1], "k--", lw=0.8, label="O(h)")
-            ax.set_title(title, fontsize=10)
-            ax.set_xlabel("h (longest edge)")
-            ax.grid(True, which="both", alpha=0.3)
+            series = [(name, [r["h"] for r in runs if q in r], [r[q] for r in runs if q in r])
+                      for name, runs in c["runs"].items()]
+            series = [s for s in series if len(s[2]) >= 2 and np.all(np.isfinite(s[2]))]
+            if series:
+                plot_convergence([s[1] for s in series], [s[2] for s in series], [s[0] for s in series],
+                                 ax=ax, title=title, legend=False)
         axes[0].legend(fontsize=7)
         fig.suptitle(cname)
         fig.tight_layout()
@@ -360,23 +358,25 @@ def _summary_plot(acc, outdir):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
+    from ..convergence import plot_convergence
     cases = [c for c in SUMMARY_CASES if c in acc and acc[c]["levels"]]
     if not cases:
         return None
     fig, axes = plt.subplots(1, len(cases), figsize=(4.2 * len(cases), 3.6), squeeze=False)
     for ax, cname in zip(axes[0], cases):
+        series = []
         for name in SUMMARY_ESTIMATORS:
             runs = acc[cname]["runs"].get(name, [])
             pts = [(r["h"], r["H"]) for r in runs if "H" in r and np.isfinite(r["H"])]
             if len(pts) >= 2:
-                h, e = zip(*pts)
-                ax.loglog(h, e, "o-" if name.startswith("hhj") else "s--", ms=4, label=name,
-                          lw=2 if name.startswith("hhj") else 1)
-        h = np.array([lv["h"] for lv in acc[cname]["levels"]])
-        ax.loglog(h, 0.3 * h / h[0], "k:", lw=1, label="O(h)")
-        ax.set_title(cname, fontsize=10)
-        ax.set_xlabel("h (longest edge)")
-        ax.grid(True, which="both", alpha=0.3)
+                series.append((name, *zip(*pts)))
+        if series:
+            hhj = [s[0].startswith("hhj") for s in series]
+            plot_convergence([s[1] for s in series], [s[2] for s in series], [s[0] for s in series], ax=ax,
+                             title=cname, legend=False,
+                             styles=[{"marker": "o" if b else "s", "ls": "-" if b else "--", "lw": 2 if b else 1}
+                                     for b in hhj])
     axes[0][0].set_ylabel("relative L2 error of H")
     axes[0][0].legend(fontsize=7)
     fig.tight_layout()

@@ -306,21 +306,26 @@ def plot_errors(results, path):
     fig, axes = plt.subplots(1, len(names), figsize=(3.6 * len(names), 3.4), squeeze=False)
     styles = {"S": ("C0", "o", "‖S‖"), "kappa_a": ("C1", "s", "‖κa‖"), "kappa_g": ("C2", "^", "‖κg‖"),
               "nu": ("C3", "v", "‖ν‖")}
+    from ..convergence import plot_convergence
     for ax, name in zip(axes[0], names):
         rows = results[name]
         h = np.array([r["h"] for r in rows])
         idx = {"nu": 0, "S": 1, "kappa_a": 3, "kappa_g": 4}
+        hs, errs, labs, sty = [], [], [], []
         for key, (c, m, lab) in styles.items():
-            e = np.array([r[key] for r in rows])
-            ax.loglog(h, e, color=c, marker=m, label=lab)
-            pe = [PAPER_TABLES[name]["rows"][k][0][idx[key]] for k in range(min(len(rows), len(PAPER_TABLES[name]["rows"])))]
-            ax.loglog(h[:len(pe)], pe, color=c, marker=m, mfc="none", ls=":", alpha=0.7)
-        top = max(r["kappa_g"] for r in rows)
-        ax.loglog(h, 1.3 * top * h / h[0], "k--", lw=0.8, label="slope 1")
-        ax.set_title(f"{name} (#F₀={rows[0]['faces']})")
-        ax.set_xlabel("h")
+            hs.append(h)
+            errs.append(np.array([r[key] for r in rows]))
+            labs.append(lab)
+            sty.append({"color": c, "marker": m})
+        for key, (c, m, lab) in styles.items():           # Walker's published errors, hollow, dotted
+            n = min(len(rows), len(PAPER_TABLES[name]["rows"]))
+            hs.append(h[:n])
+            errs.append(np.array([PAPER_TABLES[name]["rows"][k][0][idx[key]] for k in range(n)]))
+            labs.append("_nolegend_")
+            sty.append({"color": c, "marker": m, "mfc": "none", "ls": ":", "alpha": 0.7})
+        plot_convergence(hs, errs, labs, ax=ax, styles=sty, title=f"{name} (#F₀={rows[0]['faces']})",
+                         xlabel="h", legend=False)
         ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
-        ax.grid(True, which="both", alpha=0.3)
     axes[0][0].set_ylabel("L2 error (solid: igl_hhj, dotted: Walker)")
     axes[0][0].legend(fontsize=7)
     fig.tight_layout()

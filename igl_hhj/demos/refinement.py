@@ -72,22 +72,13 @@ def table(rows):
 
 
 def plot(rows, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    h = np.array([r["h"] for r in rows])
-    fig, ax = plt.subplots(figsize=(5, 4))
-    for lab, _ in METHODS:
-        ax.loglog(h, [r["err"][lab] for r in rows], "o-", label=lab)
-    ax.loglog(h, 0.5 * rows[0]["err"]["HHJ faces"] * h / h[0], "k:", label="O(h)")
-    ax.set_xlabel("h (longest edge)")
-    ax.set_ylabel("relative L2 error of H")
-    ax.set_title("re-jittered ellipsoid meshes")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend()
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    try:
+        from igl_hhj.convergence import plot_convergence
+        plot_convergence([r["h"] for r in rows], [[r["err"][lab] for r in rows] for lab, _ in METHODS],
+                         [lab for lab, _ in METHODS], ylabel="relative L2 error of H", eoc_labels=True,
+                         title="re-jittered ellipsoid meshes", path=path)
+    except ImportError as exc:
+        _common.fail(f"--plot needs matplotlib: pip install \"igl-hhj[demos]\" ({exc})")
     print(f"wrote {path}")
 
 

@@ -1,0 +1,27 @@
+"""The Examples sections of the public docstrings run (issue 14); rendering examples
+are marked +SKIP (they need EGL and write files)."""
+import doctest
+import importlib
+
+import pytest
+
+MODULES = ["igl_hhj.curvature", "igl_hhj.convergence", "igl_hhj.viewer", "igl_hhj.interop", "igl_hhj.mesh_io",
+           "igl_hhj.demos"]
+
+
+@pytest.mark.parametrize("name", MODULES)
+def test_docstring_examples(name):
+    if name == "igl_hhj.convergence":
+        import matplotlib
+        matplotlib.use("Agg")
+    result = doctest.testmod(importlib.import_module(name), optionflags=doctest.ELLIPSIS)
+    assert result.failed == 0
+
+
+def test_the_main_functions_have_examples():
+    import igl_hhj
+    from igl_hhj import convergence, viewer
+    for fn in (igl_hhj.shape_operator, igl_hhj.principal_curvature, igl_hhj.surface_hessian,
+               igl_hhj.face_principal_curvature, convergence.plot_convergence, viewer.register_curvature,
+               viewer.register_comparison, viewer.best_view_direction):
+        assert "Examples\n    --------\n    >>>" in fn.__doc__, fn.__qualname__
