@@ -25,7 +25,7 @@ import pytest
 from conftest import MESH_DIR, png_stats, require_egl
 
 ROOT = Path(__file__).resolve().parents[1]
-DEMOS = ["compare_curvature", "refinement", "boundary_data", "biharmonic", "regge"]
+DEMOS = ["quickstart", "compare_curvature", "refinement", "boundary_data", "biharmonic", "regge"]
 SIZE = (320, 200)
 MIN_STD = 0.03        # flat white: 0.0; real demo pictures: >= 0.10
 MIN_DRAWN = 0.10      # fraction of pixels that differ from the background
@@ -105,6 +105,16 @@ def test_bad_options_exit_nonzero():
 
 
 # --------------------------------------------------------------------------- rendering
+def test_quickstart(tmp_path, requires_egl):
+    out = run_demo("quickstart", tmp_path, "--out-dir", str(tmp_path))
+    for step in ("1. read", "2. verdict accepted by igl_hhj", "3. curvature", "4. picture: wrote", "5. saved"):
+        assert step in out, out
+    import igl
+    V, F = igl.read_triangle_mesh(str(tmp_path / "torus_curvature.ply"))
+    d = np.load(tmp_path / "torus_curvature.npz")
+    assert d["H"].shape == (len(V),) and np.isfinite(d["H"]).all() and len(F) == len(d["F"])
+
+
 def test_compare_curvature_generated(tmp_path, requires_egl):
     out = run_demo("compare_curvature", tmp_path)
     header, body = table_rows(out, "Relative L2 error against the exact curvature")

@@ -6,6 +6,7 @@ shows and which numbers it prints.  Some need the ``demos`` extra
 (``pip install "igl-hhj[demos]"``: matplotlib, triangle, gpytoolbox).
 
 =====================  ==========================================================
+``quickstart``         a mesh file to a curvature picture and saved results, step by step
 ``compare_curvature``  HHJ beside ``igl.principal_curvature`` on a mesh file or a generated torus
 ``refinement``         |H error| of HHJ, cotan and Heine P1 under refinement of re-jittered ellipsoids
 ``boundary_data``      open surfaces without boundary data, clamped, simply supported
@@ -18,7 +19,7 @@ from __future__ import annotations
 import importlib
 from typing import Sequence
 
-DEMOS = ("compare_curvature", "refinement", "boundary_data", "biharmonic", "regge")
+DEMOS = ("quickstart", "compare_curvature", "refinement", "boundary_data", "biharmonic", "regge")
 """Names accepted by :func:`run` and ``igl-hhj demo NAME``."""
 
 
