@@ -8,7 +8,7 @@ shows and which numbers it prints.  Some need the ``demos`` extra
 =====================  ==========================================================
 ``quickstart``         a mesh file to a curvature picture and saved results, step by step
 ``compare_curvature``  HHJ beside ``igl.principal_curvature`` on a mesh file or a generated torus
-``refinement``         |H error| of HHJ, cotan and Heine P1 under refinement of re-jittered ellipsoids
+``refinement``         ``|H_h - H|`` of HHJ, cotan and Heine P1 under refinement of re-jittered ellipsoids
 ``boundary_data``      open surfaces without boundary data, clamped, simply supported
 ``biharmonic``         mixed P1 biharmonic solution and its error, convergence rates
 ``regge``              Regge Gauss curvature K_h beside HHJ's and the exact K, Gauss–Bonnet
