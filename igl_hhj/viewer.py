@@ -227,7 +227,10 @@ def show(*, window=(1600, 900), layout=True) -> None:
                                 "use screenshot=... or run with a display")
     if layout:
         _window_layout(ps, window)
-    ps.show()
+    try:
+        ps.show()
+    finally:
+        ps.set_automatically_compute_scene_extents(True)
 
 
 def _window_layout(ps, window):
