@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from .hhj import HHJProjection, clamped_load, face_tensors
-from .mesh import TriangleMesh, as_mesh, per_vertex_array
+from .mesh import TriangleMesh, as_mesh, mark_bad_vertices, per_vertex_array
 
 __all__ = [
     "shape_operator", "surface_hessian", "principal_curvature",
@@ -359,8 +359,9 @@ def principal_curvature(V, F, radius=5, useKring=True, *, boundary_normals=None,
     PV1 : (#V,) float64, maximal curvature
     PV2 : (#V,) float64, minimal curvature (PV1 ≥ PV2)
     bad_vertices : list of int
-        Vertices without a value: the unreferenced ones, whose rows are NaN.
-        Empty for a mesh without unreferenced vertices.
+        Exactly the vertices whose rows are NaN: unreferenced vertices and
+        vertices without a tangent plane (two-sided or folded sheets, see
+        :func:`igl_hhj.mesh.mark_bad_vertices`).  Empty for a mesh without them.
 
     Positive curvature on a sphere with outward normals, as libigl.
     """
@@ -369,6 +370,6 @@ def principal_curvature(V, F, radius=5, useKring=True, *, boundary_normals=None,
     S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver)
     Sv, N = vertex_shape_operator(mesh, S)
     PD1, PD2, PV1, PV2 = vertex_principal_curvature(mesh, Sv, N)
-    bad = np.flatnonzero(~mesh.referenced_vertices).tolist()
+    PD1, PD2, PV1, PV2, bad = mark_bad_vertices(mesh, PD1, PD2, PV1, PV2)
     return (np.ascontiguousarray(PD1), np.ascontiguousarray(PD2),
             np.ascontiguousarray(PV1), np.ascontiguousarray(PV2), bad)
