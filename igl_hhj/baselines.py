@@ -49,7 +49,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .curvature import check_principal_curvature_args, vertex_principal_curvature
-from .mesh import as_mesh
+from .mesh import as_mesh, mark_bad_vertices
 
 __all__ = [
     "CurvatureEstimate", "ESTIMATORS", "estimate",
@@ -145,7 +145,7 @@ def hhj_vertex(V, F, *, shape_operator=None, **kwargs):
         mesh = as_mesh(V, F)
         Sv, N = vertex_shape_operator(mesh, _given_shape_operator(mesh, shape_operator, kwargs))
         PD1, PD2, PV1, PV2 = vertex_principal_curvature(mesh, Sv, N)
-        bad = np.flatnonzero(~mesh.referenced_vertices)
+        PD1, PD2, PV1, PV2, bad = mark_bad_vertices(mesh, PD1, PD2, PV1, PV2)
     return _ordered("hhj_vertex", "vertex", PV1, PV2, 0.5 * (PV1 + PV2), PV1 * PV2, PD1, PD2, bad)
 
 
@@ -406,7 +406,8 @@ def heine(V, F):
     K = 0.5 * (tr ** 2 - np.einsum("ijk,ikj->i", Pi, Pi))
     S = 0.5 * (Pi + np.swapaxes(Pi, 1, 2))
     d1, d2, k1, k2 = vertex_principal_curvature(mesh, S, nu)
-    return _ordered("heine", "vertex", k1, k2, H, K, d1, d2, np.flatnonzero(~mesh.referenced_vertices))
+    k1, k2, H, K, d1, d2, bad = mark_bad_vertices(mesh, k1, k2, H, K, d1, d2)
+    return _ordered("heine", "vertex", k1, k2, H, K, d1, d2, bad)
 
 
 # --------------------------------------------------------------------------- pymeshlab
