@@ -50,7 +50,17 @@ def _data_rows(mesh, A, edge_mask, name):
     if bad.any():
         raise ValueError(f"{name} is NaN or inf at boundary vertex {int(verts[bad][0])}, "
                          "where it is needed")
+    _check_magnitude(A[verts], verts, name)
     return verts
+
+
+def _check_magnitude(A, rows, name):
+    """Data beyond COORDINATE_MAX would overflow the solver's squared norms (silent NaN)."""
+    from .mesh import COORDINATE_MAX
+    big = (np.abs(A.reshape(len(A), -1)) > COORDINATE_MAX).any(axis=1)
+    if big.any():
+        raise ValueError(f"{name} has values beyond {COORDINATE_MAX:g} (they would overflow "
+                         f"float64 in the solver); first at vertex {int(rows[big][0])}: rescale")
 
 
 def _boundary_face_and_conormal(mesh, e):
@@ -196,6 +206,7 @@ def surface_hessian(V, F, w, *, boundary_gradient=None, solver="auto"):
     if not np.isfinite(W[ref]).all():
         raise ValueError(f"w has NaN or inf at vertex {int(np.flatnonzero(~np.isfinite(W).all(1) & ref)[0])}")
     W = np.where(np.isfinite(W), W, 0.0)
+    _check_magnitude(W, np.arange(len(W)), "w")
     proj = HHJProjection(mesh, solver=solver)
     load = proj.plain_boundary_load(W)
     if boundary_gradient is not None and mesh.has_boundary:
