@@ -397,8 +397,15 @@ def _one_line(text):
     return " ".join(str(text).split()) or "(no message)"
 
 
+_WARNED = set()
+
+
 def _show_warning(message, category, filename, lineno, file=None, line=None):
-    print(f"igl-hhj: warning: {_one_line(message)}", file=sys.stderr, flush=True)
+    """Warnings as ``igl-hhj: warning: ...`` lines, each message once per run."""
+    text = _one_line(message)
+    if text not in _WARNED:
+        _WARNED.add(text)
+        print(f"igl-hhj: warning: {text}", file=sys.stderr, flush=True)
 
 
 def _failure(exc):
@@ -406,10 +413,11 @@ def _failure(exc):
     from .errors import SolverError
     if isinstance(exc, UserError):
         return exc.code, _one_line(exc)
-    if isinstance(exc, MemoryError):
+    if isinstance(exc, MemoryError) or (isinstance(exc, ImportError) and any(
+            m in str(exc) for m in ("failed to map segment", "annot allocate memory"))):
         return EXIT_MEMORY, ("out of memory" + (f" ({_one_line(exc)})" if str(exc) else "")
-                             + ": the mesh is too large for the available memory; try a smaller "
-                               "mesh or a machine with more memory")
+                             + ": the computation needs more memory than this process may use; "
+                               "try a smaller mesh or raise the memory limit")
     if isinstance(exc, (SolverError, np.linalg.LinAlgError)):
         return EXIT_SOLVER, (f"the solver failed: {_one_line(exc)} (check the mesh with "
                              f"'igl-hhj info'; rerun with --debug for the traceback)")
@@ -423,6 +431,38 @@ def _failure(exc):
                            f"report it; rerun with --debug for the traceback)")
 
 
+_SIGINT_SEEN = [False]
+
+
+def _on_sigint(signum, frame):
+    _SIGINT_SEEN[0] = True
+    raise KeyboardInterrupt
+
+
+def _import_deferring_sigint(name):
+    """Import a C++ extension with Ctrl-C deferred to the end of the import: a
+    KeyboardInterrupt inside pybind11 module initialisation aborts the process
+    (``terminate called after throwing pybind11::error_already_set``)."""
+    import importlib
+    pending = []
+
+    def defer(signum, frame):
+        pending.append(signum)
+        _SIGINT_SEEN[0] = True
+
+    try:
+        previous = signal.signal(signal.SIGINT, defer)
+    except (ValueError, OSError):
+        previous = None
+    try:
+        importlib.import_module(name)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
+    if pending:
+        raise KeyboardInterrupt
+
+
 def main(argv=None):
     """Run the command line; returns the exit code (``sys.exit(main())``).
 
@@ -430,25 +470,29 @@ def main(argv=None):
     (module docstring); ``--debug`` anywhere on the command line re-raises
     failures other than user errors, with their traceback.
     """
+    _SIGINT_SEEN[0] = False
     try:
-        signal.signal(signal.SIGINT, signal.default_int_handler)   # KeyboardInterrupt from here on
+        signal.signal(signal.SIGINT, _on_sigint)          # KeyboardInterrupt from here on
     except (ValueError, OSError):
         pass
     try:
         argv = list(sys.argv[1:] if argv is None else argv)
         debug = "--debug" in argv
         argv = [a for a in argv if a != "--debug"]
+        _WARNED.clear()
         with warnings.catch_warnings():
-            warnings.simplefilter("default")
             warnings.showwarning = _show_warning
             try:
                 args = build_parser().parse_args(argv)
+                _import_deferring_sigint("igl")
                 return args.func(args)
             except SystemExit as exc:                    # --help
                 return exc.code if isinstance(exc.code, int) else 0
             except KeyboardInterrupt:
                 raise
             except Exception as exc:
+                if _SIGINT_SEEN[0]:            # e.g. pybind11 turned the interrupt into ImportError
+                    raise KeyboardInterrupt from exc
                 if debug and not isinstance(exc, UserError):
                     raise
                 code, message = _failure(exc)
@@ -460,4 +504,12 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    _code = main()
+    if _code == EXIT_INTERRUPTED:
+        # CPython remembers a KeyboardInterrupt raised inside C-level PyRun_* calls
+        # (library imports) even when it was handled, and `python -m` then ends
+        # with a re-raised SIGINT (-2) instead of our exit code: leave directly.
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(_code)
+    sys.exit(_code)
