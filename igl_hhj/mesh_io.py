@@ -395,7 +395,30 @@ def _parse_ply_header(path, head):
         raise MeshFileError(f"{path}: unknown PLY format {fmt!r}")
     if any(n < 0 for _, n, _ in elements):
         raise MeshFileError(f"{path}: corrupt PLY header: negative element count")
+    _check_ply_properties(path, elements)
     return fmt, elements, body_start
+
+
+_PLY_INT_TYPES = ("char", "int8", "uchar", "uint8", "short", "int16", "ushort", "uint16", "int",
+                  "int32", "uint", "uint32")
+
+
+def _check_ply_properties(path, elements):
+    """Known property types, vertex x/y/z and face vertex_indices (libigl's PLY reader
+    segfaults when they are missing)."""
+    for name, _, props in elements:
+        for pname, types in props:
+            scalar = types[1:] if types and types[0] == "list" else types
+            if not scalar or any(t not in _PLY_SIZES for t in scalar) or                     (types[0] == "list" and (len(types) != 3 or types[1] not in _PLY_INT_TYPES)):
+                raise MeshFileError(f"{path}: corrupt PLY header: property {pname!r} of element "
+                                    f"{name!r} has unknown type {' '.join(types)!r}")
+    named = {name: props for name, _, props in elements}
+    if "vertex" not in named or not {"x", "y", "z"} <= {p for p, t in named["vertex"] if t[0] != "list"}:
+        raise MeshFileError(f"{path}: PLY header has no 'element vertex' with properties x, y, z")
+    if "face" not in named or not any(p in ("vertex_indices", "vertex_index") and t[0] == "list"
+                                      and t[2] in _PLY_INT_TYPES for p, t in named["face"]):
+        raise MeshFileError(f"{path}: PLY header has no 'element face' with an integer list "
+                            f"property vertex_indices")
 
 
 def _check_ply(path, head, size):
