@@ -331,7 +331,7 @@ def test_info_sphere(sphere, capsys):
     assert rows["Euler char."] == "2" and rows["genus"] == "0"
     assert rows["edge-manifold"] == "yes" and rows["vertex-manifold"] == "yes"
     assert rows["orientation"] == "consistent, orientable"
-    assert rows["degenerate faces"] == "0 zero-area, 0 with a repeated vertex"
+    assert rows["degenerate faces"] == "0 zero-area or sliver, 0 with a repeated vertex"
     assert rows["verdict"] == "accepted by igl_hhj"
 
 
@@ -384,7 +384,7 @@ def moebius(n=8, w=0.3):
 
 @pytest.mark.parametrize("mesh, row, value", [
     (NONMANIFOLD, "edge-manifold", "no (1 edges with more than two faces)"),
-    (DEGENERATE, "degenerate faces", "1 zero-area, 0 with a repeated vertex"),
+    (DEGENERATE, "degenerate faces", "1 zero-area or sliver, 0 with a repeated vertex"),
     (FLIPPED, "orientation", "inconsistent (1 edges traversed twice in the same direction), orientable"),
     (moebius(), "genus", "not defined: non-orientable"),
 ], ids=["nonmanifold", "degenerate", "flipped", "moebius"])
