@@ -314,6 +314,9 @@ class BiharmonicSolver:
     ValueError
         Bad mesh (see :class:`TriangleMesh`), unknown ``bc``/``mass``/``solver``,
         or a mesh whose boundary does not match ``bc``.
+    SolverError
+        libigl's matrices are not finite for a face, or a factorisation is singular
+        in float64 (``.faces`` names the faces when known).
 
     References
     ----------
@@ -457,6 +460,8 @@ class BiharmonicSolver:
         ValueError / TypeError
             Bad data shapes or values, data not allowed for this ``bc``,
             ``f`` without zero mean for ``bc="closed"``.
+        SolverError
+            The solution is not finite (the mesh's scale overflows float64).
         """
         mesh = self.mesh
         fv = _vertex_function(mesh, f, "f", allow_none=False)
@@ -479,6 +484,12 @@ class BiharmonicSolver:
             self._solve_navier(fv, g, w, u1, u2)
         else:
             self._solve_closed(fv, project_mean, u1, u2)
+        ref = mesh.referenced_vertices
+        if not (np.isfinite(u1[ref]).all() and np.isfinite(u2[ref]).all()):
+            from .errors import SolverError
+            raise SolverError(f"the biharmonic solve overflowed float64 (longest edge "
+                              f"{mesh.max_edge_length:.3g}; u grows like length⁴ × f): rescale "
+                              f"the mesh and the data")
         return u1, u2
 
     def _solve_clamped(self, fv, g, q, u1, u2):

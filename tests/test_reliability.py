@@ -453,3 +453,21 @@ def test_triangle_soup_warns_api_and_cli(tmp_path, capsys):
     assert cli.main(["curvature", str(path)]) == 0
     err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
     assert len(err) == 1 and err[0].startswith("igl-hhj: warning: ") and "soup" in err[0]
+
+
+@pytest.mark.parametrize("scale", [1e-59, 1.0, 1e30, 1e60, 1e74])
+@pytest.mark.parametrize("bc", ["clamped", "closed"])
+def test_biharmonic_extreme_scales_finite_or_solver_error(scale, bc):
+    """u grows like length⁴: at large accepted scales the closed solve overflowed
+    into silent NaN; now finite on every referenced vertex, or SolverError."""
+    V, F = icosphere(2)
+    if bc == "clamped":
+        F = F[V[F].mean(axis=1)[:, 2] > 0]
+    kw = {"bc": "closed", "project_mean": True} if bc == "closed" else {}
+    try:
+        u1, u2 = igl_hhj.biharmonic_solve(V * scale, F, np.cos(V[:, 0]), **kw)
+    except SolverError as exc:
+        assert "rescale" in str(exc) and scale > 1e30
+        return
+    ref = TriangleMesh(V, F).referenced_vertices
+    assert np.isfinite(u1[ref]).all() and np.isfinite(u2[ref]).all()
