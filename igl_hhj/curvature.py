@@ -164,6 +164,11 @@ def shape_operator(V, F, *, boundary_normals=None, boundary_shape_operator=None,
     S : (#F, 3, 3) float64
         Symmetric tensors, tangential to each face (``S[f] @ ν_f ≈ 0``).
 
+    Raises
+    ------
+    SolverError
+        The solve did not give a finite S_h (``.faces`` lists the faces).
+
     Notes
     -----
     Without boundary data, boundary edges get the *plain assembly* (the face
@@ -173,7 +178,14 @@ def shape_operator(V, F, *, boundary_normals=None, boundary_shape_operator=None,
     allowed: A stays SPD; their values are least accurate.
     """
     mesh = as_mesh(V, F)
-    return _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver)
+    S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver)
+    bad = ~np.isfinite(S).all(axis=(1, 2))
+    if bad.any():                     # never silent NaN (issue 12)
+        from .errors import SolverError
+        raise SolverError(f"the HHJ solve returned NaN/inf on {int(bad.sum())} faces (first "
+                          f"{int(np.flatnonzero(bad)[0])}); try solver='direct'",
+                          faces=np.flatnonzero(bad))
+    return S
 
 
 def surface_hessian(V, F, w, *, boundary_gradient=None, solver="auto"):
