@@ -95,7 +95,7 @@ def _too_short(path, what, need, have):
 
 
 # --------------------------------------------------------------------------- body scan
-_CHUNK = 1 << 25          # bytes of the file per vectorised pass (bounds temporary memory)
+_CHUNK = 1 << 22          # bytes of the file per vectorised pass (bounds temporary memory)
 
 
 def _char_table(chars):
@@ -132,7 +132,7 @@ class _Lines:
     FIELDS = ("offset", "lineno", "ntok", "c0", "flen", "first", "n_num", "n_corner",
               "zero_corner", "int_k")
 
-    def __init__(self, path, start, comments=True, first_line=1):
+    def __init__(self, path, start, comments=True, first_line=1, corners=False):
         parts = {k: [] for k in self.FIELDS}
         line0, pos0 = first_line, start
         with open(path, "rb") as fh:
@@ -148,7 +148,7 @@ class _Lines:
                         continue
                     data, carry = data[:cut], data[cut:]
                 if data:
-                    for k, v in self._scan(data, comments).items():
+                    for k, v in self._scan(data, comments, corners).items():
                         parts[k].append(v)
                     parts["lineno"][-1] += line0
                     parts["offset"][-1] += pos0
@@ -163,7 +163,7 @@ class _Lines:
         return len(self.ntok)
 
     @staticmethod
-    def _scan(data, comments):
+    def _scan(data, comments, corners):
         buf = np.frombuffer(data, dtype=np.uint8)
         n = buf.size
         space = _WS[buf]
@@ -175,10 +175,15 @@ class _Lines:
             np.add.at(delta, hashes, 1)
             np.add.at(delta, ends, -1)
             space |= np.cumsum(delta[:n]) > 0
-        tok = (~space).view(np.int8)
-        edge = np.diff(np.concatenate([[0], tok, [0]]))
-        s = np.flatnonzero(edge == 1)
-        e = np.flatnonzero(edge == -1)
+        inside = ~space
+        before = np.empty(n, dtype=bool)                            # previous char is space
+        before[0] = True
+        before[1:] = space[:-1]
+        s = np.flatnonzero(inside & before)                         # token starts
+        before[:-1] = space[1:]                                     # (reused: next char is space)
+        before[-1] = True
+        e = np.flatnonzero(inside & before) + 1                     # token ends (exclusive)
+        del before
         line = np.searchsorted(nl, s)                               # line of each token (block)
         head = np.flatnonzero(np.concatenate([[True], line[1:] != line[:-1]])) if s.size \
             else np.zeros(0, dtype=np.int64)
@@ -187,23 +192,30 @@ class _Lines:
         pos = np.arange(s.size) - head[owner] if s.size else np.zeros(0, dtype=np.int64)
         starts = np.concatenate([[0], nl + 1])[line[head]] if head.size else head
 
-        def every(table):                                           # every character of the token
-            bad = np.concatenate([[0], np.cumsum(~table[buf] & ~space, dtype=np.int64)])
-            return bad[e] - bad[s] == 0
+        pre = np.empty(n + 1, dtype=np.int32)                       # n ≤ 2 × _CHUNK < 2³¹
+        pre[0] = 0
 
-        nd = np.concatenate([[0], np.cumsum(_DIGIT[buf], dtype=np.int64)])
-        has_digit = nd[e] - nd[s] > 0
+        def count(mask):                                            # per token: chars in mask
+            np.cumsum(mask & inside, dtype=np.int32, out=pre[1:])
+            return pre[e] - pre[s]
+
+        def every(table):                                           # every character of the token
+            return count(~table[buf]) == 0
+
+        has_digit = count(_DIGIT[buf]) > 0
         digits = every(_DIGIT)
         number = every(_NUMBER) & has_digit
-        corner = every(_CORNER) & has_digit
-        zc = np.flatnonzero(buf == 48)                              # a component "0" of a corner
-        before = np.where(zc > 0, buf[np.maximum(zc - 1, 0)], 32)
-        after = np.where(zc < n - 1, buf[np.minimum(zc + 1, n - 1)], 32)
-        zc = zc[((before == 47) | _WS[before]) & ((after == 47) | _WS[after])]
+        corner = np.zeros(s.size, dtype=bool)
         zero = np.zeros(s.size, dtype=bool)
-        if zc.size and s.size:
-            t = np.searchsorted(s, zc, side="right") - 1
-            zero[t[(t >= 0) & (zc < e[np.maximum(t, 0)])]] = True
+        if corners:                                                 # OBJ face corners
+            corner = every(_CORNER) & has_digit
+            zc = np.flatnonzero(buf == 48)                          # a component "0" of a corner
+            before = np.where(zc > 0, buf[np.maximum(zc - 1, 0)], 32)
+            after = np.where(zc < n - 1, buf[np.minimum(zc + 1, n - 1)], 32)
+            zc = zc[((before == 47) | _WS[before]) & ((after == 47) | _WS[after])]
+            if zc.size and s.size:
+                t = np.searchsorted(s, zc, side="right") - 1
+                zero[t[(t >= 0) & (zc < e[np.maximum(t, 0)])]] = True
         fs, flen = s[head], (e - s)[head]
         first = np.where(digits[head] & (flen <= 18), 0, -1).astype(np.int64)
         for j in range(18):
@@ -268,7 +280,7 @@ def _check_rows(path, L, rows, bad, what):
 
 def _check_obj(path):
     """``v`` lines numeric, ``f`` lines made of corner indices, and 1-based."""
-    L = _Lines(path, 0)
+    L = _Lines(path, 0, corners=True)
     one = L.flen == 1
     v = one & (L.c0 == ord("v"))
     f = one & (L.c0 == ord("f"))

@@ -471,3 +471,20 @@ def test_biharmonic_extreme_scales_finite_or_solver_error(scale, bc):
         return
     ref = TriangleMesh(V, F).referenced_vertices
     assert np.isfinite(u1[ref]).all() and np.isfinite(u2[ref]).all()
+
+
+def test_file_guard_reports_the_right_line_across_chunks(tmp_path, monkeypatch):
+    """The body scan runs in chunks of _CHUNK bytes: line numbers stay exact."""
+    from igl_hhj import mesh_io
+    monkeypatch.setattr(mesh_io, "_CHUNK", 4096)                 # many chunks on a small file
+    V, F = icosphere(3)
+    path = write_off(tmp_path / "s.off", V, F)
+    lines = path.read_bytes().split(b"\n")
+    k = len(lines) - 7
+    lines[k] = lines[k].replace(b" ", b" 1x ", 1)
+    path.write_bytes(b"\n".join(lines))
+    with pytest.raises(mesh_io.MeshFileError, match=rf"line {k + 1}: face corner is not"):
+        mesh_io.read_mesh(path)
+    path.write_bytes(write_off(tmp_path / "t.off", V, F).read_bytes())
+    V2, F2, _ = mesh_io.read_mesh(path)                            # the valid file still reads
+    assert len(F2) == len(F)
