@@ -1,6 +1,6 @@
 """igl_hhj: provably convergent finite-element curvature for libigl triangle meshes.
 
-Core (imported eagerly, needs only libigl, numpy, scipy):
+Core (needs only libigl, numpy, scipy; imported on first use):
 
 * :func:`shape_operator` — Walker's surface-HHJ shape operator S_h, one tensor per face;
 * :func:`surface_hessian` — HHJ projection of the surface Hessian of a P1 function;
@@ -21,23 +21,21 @@ biharmonic solver, also as :func:`biharmonic_solve`), :mod:`igl_hhj.baselines`
 """
 import importlib
 
-from .curvature import (
-    face_gaussian_curvature,
-    face_mean_curvature,
-    face_principal_curvature,
-    principal_curvature,
-    principal_from_shape_operator,
-    shape_operator,
-    surface_hessian,
-)
-from .errors import SolverDidNotConverge, SolverError
-from .mesh import TriangleMesh, validate_mesh
-
 __version__ = "0.1.0"
 
 _LAZY_MODULES = {"regge", "biharmonic", "baselines", "viewer", "surfaces", "benchmarks",
-                 "hhj", "mesh", "convergence", "cli", "mesh_io", "mesh_report", "interop", "demos"}
-_LAZY_ATTRS = {"biharmonic_solve": "biharmonic", "BiharmonicSolver": "biharmonic"}
+                 "hhj", "mesh", "convergence", "cli", "mesh_io", "mesh_report",
+                 "curvature", "errors", "interop", "demos"}
+# The core names resolve on first use too, so that ``import igl_hhj`` (and the
+# ``igl-hhj`` command's start-up, where Ctrl-C must not print a traceback) costs
+# no numpy/scipy import.
+_LAZY_ATTRS = {"biharmonic_solve": "biharmonic", "BiharmonicSolver": "biharmonic",
+               **{name: "curvature" for name in (
+                   "face_gaussian_curvature", "face_mean_curvature", "face_principal_curvature",
+                   "principal_curvature", "principal_from_shape_operator", "shape_operator",
+                   "surface_hessian")},
+               "SolverError": "errors", "SolverDidNotConverge": "errors",
+               "TriangleMesh": "mesh", "validate_mesh": "mesh"}
 
 __all__ = [
     "shape_operator", "surface_hessian", "principal_curvature",
@@ -52,7 +50,9 @@ def __getattr__(name):
     if name in _LAZY_MODULES:
         return importlib.import_module(f".{name}", __name__)
     if name in _LAZY_ATTRS:
-        return getattr(importlib.import_module(f".{_LAZY_ATTRS[name]}", __name__), name)
+        value = getattr(importlib.import_module(f".{_LAZY_ATTRS[name]}", __name__), name)
+        globals()[name] = value              # resolve once
+        return value
     raise AttributeError(f"module 'igl_hhj' has no attribute {name!r}")
 
 

@@ -49,7 +49,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .curvature import check_principal_curvature_args, vertex_principal_curvature
-from .mesh import as_mesh
+from .mesh import as_mesh, mark_bad_vertices
 
 __all__ = [
     "CurvatureEstimate", "ESTIMATORS", "estimate",
@@ -145,7 +145,7 @@ def hhj_vertex(V, F=None, *, shape_operator=None, **kwargs):
         mesh = as_mesh(V, F)
         Sv, N = vertex_shape_operator(mesh, _given_shape_operator(mesh, shape_operator, kwargs))
         PD1, PD2, PV1, PV2 = vertex_principal_curvature(mesh, Sv, N)
-        bad = np.flatnonzero(~mesh.referenced_vertices)
+        PD1, PD2, PV1, PV2, bad = mark_bad_vertices(mesh, PD1, PD2, PV1, PV2)
     return _ordered("hhj_vertex", "vertex", PV1, PV2, 0.5 * (PV1 + PV2), PV1 * PV2, PD1, PD2, bad)
 
 
@@ -199,10 +199,13 @@ def libigl_quadric(V, F, radius=5, useKring=True):
     import igl
     check_principal_curvature_args(radius, useKring)
     mesh = as_mesh(V, F)
-    PD1, PD2, PV1, PV2, bad = igl.principal_curvature(mesh.V, mesh.F, int(radius), bool(useKring))
+    # libigl's fit has absolute tolerances: it returns zeros below edge lengths ~1e-15
+    # (measured), so fit on the mesh scaled to unit mean edge length and scale back.
+    s = mesh.mean_edge_length
+    PD1, PD2, PV1, PV2, bad = igl.principal_curvature(mesh.V / s, mesh.F, int(radius), bool(useKring))
     bad = np.concatenate([np.asarray(bad, dtype=np.int64), np.flatnonzero(~mesh.referenced_vertices)])
-    PV1 = np.asarray(PV1, dtype=np.float64)
-    PV2 = np.asarray(PV2, dtype=np.float64)
+    PV1 = np.asarray(PV1, dtype=np.float64) / s
+    PV2 = np.asarray(PV2, dtype=np.float64) / s
     return _ordered("libigl_quadric", "vertex", PV1, PV2, 0.5 * (PV1 + PV2), PV1 * PV2,
                     np.asarray(PD1), np.asarray(PD2), bad)
 
@@ -217,7 +220,10 @@ def _square(A, n):
 
 def _cotmatrix(mesh):
     import igl
-    return _square(igl.cotmatrix(mesh.V, mesh.F), mesh.n_vertices)
+
+    from .biharmonic import _finite_operator
+    return _finite_operator(mesh, _square(igl.cotmatrix(mesh.V, mesh.F), mesh.n_vertices),
+                            "the cotangent matrix (igl.cotmatrix)")
 
 
 def _voronoi_mass(mesh):
@@ -297,19 +303,25 @@ def libigl_cotan(V, F):
 # --------------------------------------------------------------------------- Heine
 def _consistent_mass(mesh):
     import igl
-    return _square(igl.massmatrix(mesh.V, mesh.F, igl.MASSMATRIX_TYPE_FULL), mesh.n_vertices)
+
+    from .biharmonic import _finite_operator
+    return _finite_operator(mesh, _square(igl.massmatrix(mesh.V, mesh.F, igl.MASSMATRIX_TYPE_FULL),
+                                          mesh.n_vertices), "the mass matrix (igl.massmatrix)")
 
 
 def _mass_solve(mesh, M, R):
     """Solve ``M X = R`` on the referenced vertices (unreferenced rows → NaN)."""
     from .hhj import solve_spd
+    from .errors import SolverError
     ref = mesh.referenced_vertices
     X = np.full(R.shape, np.nan)
-    if ref.all():
-        X[:] = solve_spd(M, R, method="cg", rtol=1e-12)
-    else:
-        idx = np.flatnonzero(ref)
-        X[idx] = solve_spd(M[idx][:, idx], R[idx], method="cg", rtol=1e-12)
+    if not np.isfinite(R[ref]).all():
+        raise SolverError("Heine's load vector is not finite: rescale the mesh")
+    idx = np.flatnonzero(ref)
+    X[idx] = solve_spd(M[idx][:, idx], R[idx], method="cg", rtol=1e-12)
+    if not np.isfinite(X[idx]).all():
+        raise SolverError("Heine's mass-matrix solve returned NaN/inf (the mesh's scale or a "
+                          "near-degenerate face is beyond float64): rescale the mesh")
     return X
 
 
@@ -394,7 +406,8 @@ def heine(V, F):
     K = 0.5 * (tr ** 2 - np.einsum("ijk,ikj->i", Pi, Pi))
     S = 0.5 * (Pi + np.swapaxes(Pi, 1, 2))
     d1, d2, k1, k2 = vertex_principal_curvature(mesh, S, nu)
-    return _ordered("heine", "vertex", k1, k2, H, K, d1, d2, np.flatnonzero(~mesh.referenced_vertices))
+    k1, k2, H, K, d1, d2, bad = mark_bad_vertices(mesh, k1, k2, H, K, d1, d2)
+    return _ordered("heine", "vertex", k1, k2, H, K, d1, d2, bad)
 
 
 # --------------------------------------------------------------------------- pymeshlab

@@ -108,7 +108,8 @@ def stiffness_matrix(mesh):
     K : (#V, #V) scipy.sparse.csr_matrix
     """
     import igl
-    return _pad(-igl.cotmatrix(mesh.V, mesh.F), mesh.n_vertices)
+    return _finite_operator(mesh, _pad(-igl.cotmatrix(mesh.V, mesh.F), mesh.n_vertices),
+                            "the stiffness matrix (igl.cotmatrix)")
 
 
 def mass_matrix(mesh, kind="full"):
@@ -128,7 +129,8 @@ def mass_matrix(mesh, kind="full"):
              "voronoi": igl.MASSMATRIX_TYPE_VORONOI}
     if kind not in types:
         raise ValueError(f"mass must be one of {MASS_TYPES}, got {kind!r}")
-    return _pad(igl.massmatrix(mesh.V, mesh.F, types[kind]), mesh.n_vertices)
+    return _finite_operator(mesh, _pad(igl.massmatrix(mesh.V, mesh.F, types[kind]), mesh.n_vertices),
+                            "the mass matrix (igl.massmatrix)")
 
 
 def _pad(A, n):
@@ -174,8 +176,12 @@ def _factorize_spd(A):
     if A.shape[0] == 0:
         return lambda b: np.zeros_like(b)
     p = reverse_cuthill_mckee(A, symmetric_mode=True)
-    lu = spla.splu(sp.csc_matrix(A[p][:, p]), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                   options={"SymmetricMode": True})
+    _check_finite_matrix(A)
+    try:
+        lu = spla.splu(sp.csc_matrix(A[p][:, p]), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                       options={"SymmetricMode": True})
+    except RuntimeError:            # a zero pivot without pivoting: retry with partial pivoting
+        lu = _splu_or_solver_error(sp.csc_matrix(A[p][:, p]), "COLAMD")
 
     def solve(b):
         x = np.empty_like(b)
@@ -187,8 +193,42 @@ def _factorize_spd(A):
 
 def _factorize_general(A):
     """Sparse LU with partial pivoting (COLAMD); for the indefinite system (6.1)."""
-    lu = spla.splu(sp.csc_matrix(A), permc_spec="COLAMD")
-    return lu.solve
+    _check_finite_matrix(A)
+    return _splu_or_solver_error(sp.csc_matrix(A), "COLAMD").solve
+
+
+def _check_finite_matrix(A):
+    if not np.isfinite(sp.csr_matrix(A).data).all():
+        from .errors import SolverError
+        raise SolverError("the biharmonic system has NaN/inf entries: libigl's cotangent/mass "
+                          "matrices could not represent a face of this mesh; remove "
+                          "near-degenerate faces or rescale the mesh")
+
+
+def _finite_operator(mesh, A, what):
+    """Raise SolverError naming the faces where a libigl operator is not finite."""
+    A = sp.csr_matrix(A)
+    bad = ~np.isfinite(A.data)
+    if bad.any():
+        from .errors import SolverError
+        rows = np.repeat(np.arange(A.shape[0]), np.diff(A.indptr))[bad]
+        vmask = np.zeros(mesh.n_vertices, dtype=bool)
+        vmask[rows[rows < mesh.n_vertices]] = True
+        faces = np.flatnonzero(vmask[mesh.F].all(axis=1))
+        raise SolverError(f"{what} has NaN/inf entries around faces {faces[:5].tolist()}: libigl "
+                          f"computes it from edge lengths and cannot represent those faces; "
+                          f"remove near-degenerate faces or rescale the mesh", faces=faces)
+    return A
+
+
+def _splu_or_solver_error(A, permc):
+    from .errors import SolverError
+    try:
+        return spla.splu(A, permc_spec=permc)
+    except RuntimeError as exc:
+        raise SolverError(f"the biharmonic system is singular in float64 ({exc}): the mesh has a "
+                          "face or component the P1 matrices cannot represent (near-degenerate "
+                          "faces, or a component without boundary for bc='clamped'/'navier')") from None
 
 
 # ---------------------------------------------------------------- input checks
@@ -274,6 +314,9 @@ class BiharmonicSolver:
     ValueError
         Bad mesh (see :class:`TriangleMesh`), unknown ``bc``/``mass``/``solver``,
         or a mesh whose boundary does not match ``bc``.
+    SolverError
+        libigl's matrices are not finite for a face, or a factorisation is singular
+        in float64 (``.faces`` names the faces when known).
 
     References
     ----------
@@ -417,6 +460,8 @@ class BiharmonicSolver:
         ValueError / TypeError
             Bad data shapes or values, data not allowed for this ``bc``,
             ``f`` without zero mean for ``bc="closed"``.
+        SolverError
+            The solution is not finite (the mesh's scale overflows float64).
         """
         mesh = self.mesh
         fv = _vertex_function(mesh, f, "f", allow_none=False)
@@ -439,6 +484,12 @@ class BiharmonicSolver:
             self._solve_navier(fv, g, w, u1, u2)
         else:
             self._solve_closed(fv, project_mean, u1, u2)
+        ref = mesh.referenced_vertices
+        if not (np.isfinite(u1[ref]).all() and np.isfinite(u2[ref]).all()):
+            from .errors import SolverError
+            raise SolverError(f"the biharmonic solve overflowed float64 (longest edge "
+                              f"{mesh.max_edge_length:.3g}; u grows like length⁴ × f): rescale "
+                              f"the mesh and the data")
         return u1, u2
 
     def _solve_clamped(self, fv, g, q, u1, u2):

@@ -16,21 +16,43 @@ Commands
 Exit codes
 ----------
 0 success; 1 ``info``: the file was read but igl_hhj rejects the mesh;
-2 user error (missing / unreadable / malformed file, a mesh igl_hhj rejects in
-``curvature``, bad options, unwritable output, viewer unavailable for
-``--view`` / ``--screenshot``).  User errors print exactly one line
-``igl-hhj: error: ...`` on stderr; programming errors raise.
+2 user error (a mesh igl_hhj rejects in ``curvature``, bad options, unwritable
+output, viewer unavailable for ``--view`` / ``--screenshot``); 3 unreadable mesh
+file (missing, unreadable, malformed, truncated); 4 the solver failed on an
+accepted mesh; 5 out of memory; 70 internal error (a bug: please report it);
+130 interrupted (Ctrl-C).  Every failure prints exactly one line
+``igl-hhj: error: ...`` on stderr (warnings: ``igl-hhj: warning: ...``); no
+traceback unless ``--debug`` is given.
 """
 from __future__ import annotations
 
-import argparse
+import os
+import signal
 import sys
-import time
-from pathlib import Path
 
-import numpy as np
 
-from .mesh_io import CapturedOutput
+def _interrupted_at_startup(signum, frame):      # Ctrl-C while the imports below run
+    sys.stderr.write("igl-hhj: interrupted\n")
+    os._exit(130)
+
+
+if __name__ == "__main__" or os.path.basename(sys.argv[0] if sys.argv else "") in ("igl-hhj", "cli.py"):
+    try:
+        signal.signal(signal.SIGINT, _interrupted_at_startup)
+    except (ValueError, OSError):                # not the main thread
+        pass
+
+import argparse  # noqa: E402
+import time  # noqa: E402
+import warnings  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from .mesh_io import CapturedOutput  # noqa: E402
+
+EXIT_REJECTED, EXIT_USAGE, EXIT_UNREADABLE, EXIT_SOLVER, EXIT_MEMORY = 1, 2, 3, 4, 5
+EXIT_INTERNAL, EXIT_INTERRUPTED = 70, 130
 
 EGL_HINT = ("headless rendering needs EGL; on Debian/Ubuntu: "
             "apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri")
@@ -87,7 +109,7 @@ def _read(path):
     try:
         V, F, messages = read_mesh(path)
     except MeshFileError as exc:
-        raise UserError(str(exc)) from None
+        raise UserError(str(exc), EXIT_UNREADABLE) from None
     if messages:
         more = f" (+{len(messages) - 2} more)" if len(messages) > 2 else ""
         print(f"igl-hhj: warning: {path}: " + "; ".join(messages[:2]) + more, file=sys.stderr)
@@ -134,6 +156,10 @@ def _demo(args):
 
     if args.levels < 1:
         raise UserError(f"--levels must be at least 1, got {args.levels}")
+    if args.levels > 7:
+        raise UserError(f"--levels must be at most 7 (level 7 has 1.3 million faces), got {args.levels}")
+    if not 0 <= args.seed < 2 ** 63:
+        raise UserError(f"--seed must be a non-negative integer below 2**63, got {args.seed}")
     if min(args.size) < 16:
         raise UserError(f"--size must be at least 16 16 pixels, got {args.size[0]} {args.size[1]}")
     shot = None if args.no_screenshot else args.screenshot
@@ -257,10 +283,8 @@ def _curvature(args):
         say(f"  {name:>3}: 1% {q[0]: .4g}   median {q[1]: .4g}   99% {q[2]: .4g}")
     n_nan = int(np.isnan(est.k1).sum())
     if n_nan:
-        why = {"hhj": "unreferenced vertices", "heine": "unreferenced vertices",
-               "igl": "unreferenced vertices and those libigl flags as bad (< 6 neighbours)"}
         say(f"  {n_nan} {'vertice' if per == 'vertex' else 'face'}s have no value (NaN): "
-              f"{why[args.method]}")
+            f"{_nan_reasons(mesh, est, args.method)}")
 
     if args.out is not None:
         _write(stages, args, mesh, est, S)
@@ -285,6 +309,26 @@ def _curvature(args):
                 raise UserError(f"no screenshot: {_with_hint(exc)}") from None
             say(f"  wrote {args.screenshot}")
     return 0
+
+
+def _nan_reasons(mesh, est, method):
+    """Why rows are NaN, with counts (the causes ``bad_vertices`` documents)."""
+    nan = np.isnan(est.k1)
+    if est.location != "vertex":
+        return "the solver returned no value there"
+    unref = nan & ~mesh.referenced_vertices
+    folded = nan & mesh.folded_vertices
+    rest = nan & ~unref & ~folded
+    parts = []
+    if unref.any():
+        parts.append(f"{int(unref.sum())} unreferenced")
+    if folded.any():
+        parts.append(f"{int(folded.sum())} without a tangent plane (the faces around them cancel: "
+                     f"a two-sided or folded sheet, first vertex {int(np.flatnonzero(folded)[0])})")
+    if rest.any():
+        why = "flagged by libigl (< 6 neighbours)" if method == "igl" else "non-finite estimate"
+        parts.append(f"{int(rest.sum())} {why}")
+    return ", ".join(parts)
 
 
 def _write(stages, args, mesh, est, S):
@@ -349,7 +393,11 @@ def _named_demo(argv):
 def build_parser():
     parser = _Parser(prog="igl-hhj",
                      description="igl_hhj: convergent finite-element (HHJ) curvature of triangle meshes.",
-                     epilog="exit codes: 0 ok, 1 info: mesh rejected, 2 user error")
+                     epilog="exit codes: 0 ok, 1 info: mesh rejected, 2 user error, 3 unreadable "
+                            "mesh file, 4 solver failure, 5 out of memory, 70 internal error, "
+                            "130 interrupted")
+    parser.add_argument("--debug", action="store_true",
+                        help="show the Python traceback of a failure (anywhere on the command line)")
     parser.add_argument("--version", action="version", version=_version(),
                         help="print the versions of igl-hhj and libigl and exit")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -416,23 +464,127 @@ def build_parser():
     return parser
 
 
-def main(argv=None):
-    """Run the command line; returns the exit code (``sys.exit(main())``)."""
+def _one_line(text):
+    """Collapse a message to one line (C++/numpy messages may span several)."""
+    return " ".join(str(text).split()) or "(no message)"
+
+
+_WARNED = set()
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None):
+    """Warnings as ``igl-hhj: warning: ...`` lines, each message once per run."""
+    text = _one_line(message)
+    if text not in _WARNED:
+        _WARNED.add(text)
+        print(f"igl-hhj: warning: {text}", file=sys.stderr, flush=True)
+
+
+def _failure(exc):
+    """(exit code, one-line message) for an exception that ended a command."""
+    from .errors import SolverError
+    if isinstance(exc, UserError):
+        return exc.code, _one_line(exc)
+    if isinstance(exc, MemoryError) or (isinstance(exc, ImportError) and any(
+            m in str(exc) for m in ("failed to map segment", "annot allocate memory"))):
+        return EXIT_MEMORY, ("out of memory" + (f" ({_one_line(exc)})" if str(exc) else "")
+                             + ": the computation needs more memory than this process may use; "
+                               "try a smaller mesh or raise the memory limit")
+    if isinstance(exc, (SolverError, np.linalg.LinAlgError)):
+        return EXIT_SOLVER, (f"the solver failed: {_one_line(exc)} (check the mesh with "
+                             f"'igl-hhj info'; rerun with --debug for the traceback)")
+    if isinstance(exc, RuntimeError):
+        return EXIT_SOLVER, (f"computation failed: {_one_line(exc)} (rerun with --debug for "
+                             f"the traceback)")
+    if isinstance(exc, OSError):
+        return EXIT_USAGE, _one_line(f"{exc.filename + ': ' if exc.filename else ''}"
+                                     f"{exc.strerror or exc}")
+    return EXIT_INTERNAL, (f"internal error: {type(exc).__name__}: {_one_line(exc)} (please "
+                           f"report it; rerun with --debug for the traceback)")
+
+
+_SIGINT_SEEN = [False]
+
+
+def _on_sigint(signum, frame):
+    _SIGINT_SEEN[0] = True
+    raise KeyboardInterrupt
+
+
+def _import_deferring_sigint(name):
+    """Import a C++ extension with Ctrl-C deferred to the end of the import: a
+    KeyboardInterrupt inside pybind11 module initialisation aborts the process
+    (``terminate called after throwing pybind11::error_already_set``)."""
+    import importlib
+    pending = []
+
+    def defer(signum, frame):
+        pending.append(signum)
+        _SIGINT_SEEN[0] = True
+
     try:
-        named = _named_demo(argv)
-        if named is not None:
-            return named
-        args = build_parser().parse_args(argv)
-        return args.func(args)
-    except UserError as exc:
-        print(f"igl-hhj: error: {exc}", file=sys.stderr)
-        return exc.code
-    except SystemExit as exc:                    # --help
-        return exc.code if isinstance(exc.code, int) else 0
+        previous = signal.signal(signal.SIGINT, defer)
+    except (ValueError, OSError):
+        previous = None
+    try:
+        importlib.import_module(name)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
+    if pending:
+        raise KeyboardInterrupt
+
+
+def main(argv=None):
+    """Run the command line; returns the exit code (``sys.exit(main())``).
+
+    Every exception ends as one ``igl-hhj: error: ...`` line and an exit code
+    (module docstring); ``--debug`` anywhere on the command line re-raises
+    failures other than user errors, with their traceback.
+    """
+    _SIGINT_SEEN[0] = False
+    try:
+        signal.signal(signal.SIGINT, _on_sigint)          # KeyboardInterrupt from here on
+    except (ValueError, OSError):
+        pass
+    try:
+        argv = list(sys.argv[1:] if argv is None else argv)
+        debug = "--debug" in argv
+        argv = [a for a in argv if a != "--debug"]
+        _WARNED.clear()
+        with warnings.catch_warnings():
+            warnings.showwarning = _show_warning
+            try:
+                named = _named_demo(argv)
+                if named is not None:
+                    return named
+                args = build_parser().parse_args(argv)
+                _import_deferring_sigint("igl")
+                return args.func(args)
+            except SystemExit as exc:                    # --help
+                return exc.code if isinstance(exc.code, int) else 0
+            except KeyboardInterrupt:
+                raise
+            except Exception as exc:
+                if _SIGINT_SEEN[0]:            # e.g. pybind11 turned the interrupt into ImportError
+                    raise KeyboardInterrupt from exc
+                if debug and not isinstance(exc, UserError):
+                    raise
+                code, message = _failure(exc)
+                print(f"igl-hhj: error: {message}", file=sys.stderr)
+                return code
     except KeyboardInterrupt:
         print("igl-hhj: interrupted", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    _code = main()
+    if _code == EXIT_INTERRUPTED:
+        # CPython remembers a KeyboardInterrupt raised inside C-level PyRun_* calls
+        # (library imports) even when it was handled, and `python -m` then ends
+        # with a re-raised SIGINT (-2) instead of our exit code: leave directly.
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(_code)
+    sys.exit(_code)

@@ -13,7 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .hhj import HHJProjection, clamped_load, face_tensors
-from .mesh import TriangleMesh, as_mesh, per_vertex_array
+from .mesh import TriangleMesh, as_mesh, mark_bad_vertices, per_vertex_array
 
 __all__ = [
     "shape_operator", "surface_hessian", "principal_curvature",
@@ -53,7 +53,17 @@ def _data_rows(mesh, A, edge_mask, name):
     if bad.any():
         raise ValueError(f"{name} is NaN or inf at boundary vertex {int(verts[bad][0])}, "
                          "where it is needed")
+    _check_magnitude(A[verts], verts, name)
     return verts
+
+
+def _check_magnitude(A, rows, name):
+    """Data beyond COORDINATE_MAX would overflow the solver's squared norms (silent NaN)."""
+    from .mesh import COORDINATE_MAX
+    big = (np.abs(A.reshape(len(A), -1)) > COORDINATE_MAX).any(axis=1)
+    if big.any():
+        raise ValueError(f"{name} has values beyond {COORDINATE_MAX:g} (they would overflow "
+                         f"float64 in the solver); first at vertex {int(rows[big][0])}: rescale")
 
 
 def _boundary_face_and_conormal(mesh, e):
@@ -158,6 +168,11 @@ def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary_normals: Arra
     S : (#F, 3, 3) float64
         Symmetric tensors, tangential to each face (``S[f] @ ν_f ≈ 0``).
 
+    Raises
+    ------
+    SolverError
+        The solve did not give a finite S_h (``.faces`` lists the faces).
+
     Notes
     -----
     Without boundary data, boundary edges get the *plain assembly* (the face
@@ -177,7 +192,14 @@ def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary_normals: Arra
     2.0
     """
     mesh = as_mesh(V, F)
-    return _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver)
+    S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver)
+    bad = ~np.isfinite(S).all(axis=(1, 2))
+    if bad.any():                     # never silent NaN (issue 12)
+        from .errors import SolverError
+        raise SolverError(f"the HHJ solve returned NaN/inf on {int(bad.sum())} faces (first "
+                          f"{int(np.flatnonzero(bad)[0])}); try solver='direct'",
+                          faces=np.flatnonzero(bad))
+    return S
 
 
 def surface_hessian(V: Any, F: ArrayLike | None, w: ArrayLike, *, boundary_gradient: ArrayLike | None = None,
@@ -218,6 +240,7 @@ def surface_hessian(V: Any, F: ArrayLike | None, w: ArrayLike, *, boundary_gradi
     if not np.isfinite(W[ref]).all():
         raise ValueError(f"w has NaN or inf at vertex {int(np.flatnonzero(~np.isfinite(W).all(1) & ref)[0])}")
     W = np.where(np.isfinite(W), W, 0.0)
+    _check_magnitude(W, np.arange(len(W)), "w")
     proj = HHJProjection(mesh, solver=solver)
     load = proj.plain_boundary_load(W)
     if boundary_gradient is not None and mesh.has_boundary:
@@ -392,8 +415,9 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
     PV1 : (#V,) float64, maximal curvature
     PV2 : (#V,) float64, minimal curvature (PV1 ≥ PV2)
     bad_vertices : list of int
-        Vertices without a value: the unreferenced ones, whose rows are NaN.
-        Empty for a mesh without unreferenced vertices.
+        Exactly the vertices whose rows are NaN: unreferenced vertices and
+        vertices without a tangent plane (two-sided or folded sheets, see
+        :func:`igl_hhj.mesh.mark_bad_vertices`).  Empty for a mesh without them.
 
     Positive curvature on a sphere with outward normals, as libigl.
     Examples
@@ -412,6 +436,6 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
     S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver)
     Sv, N = vertex_shape_operator(mesh, S)
     PD1, PD2, PV1, PV2 = vertex_principal_curvature(mesh, Sv, N)
-    bad = np.flatnonzero(~mesh.referenced_vertices).tolist()
+    PD1, PD2, PV1, PV2, bad = mark_bad_vertices(mesh, PD1, PD2, PV1, PV2)
     return (np.ascontiguousarray(PD1), np.ascontiguousarray(PD2),
             np.ascontiguousarray(PV1), np.ascontiguousarray(PV2), bad)

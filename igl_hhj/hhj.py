@@ -163,6 +163,32 @@ def clamped_load(mesh: TriangleMesh, edge_mask, gradient):
     return g
 
 
+def _guarded_block_inverse(blk):
+    """Inverses of the (#F, 3, 3) face blocks; a block that is singular in float64
+    (a sliver at the validation threshold) gets its Jacobi inverse instead, so
+    the preconditioner stays SPD instead of raising ``LinAlgError``.
+    (Minimal guard added by the "rel" helper, issue 12.)"""
+    try:
+        return np.linalg.inv(blk)
+    except np.linalg.LinAlgError:
+        pass
+    d = np.einsum("fii->fi", blk)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        jac = np.where(d > 0, 1.0 / d, 0.0)
+    inv = np.zeros_like(blk)
+    idx = np.arange(3)
+    inv[:, idx, idx] = jac
+    det = np.linalg.det(blk)
+    scale = np.prod(np.abs(d), axis=1)
+    ok = np.isfinite(det) & (np.abs(det) > 1e-14 * scale)
+    if ok.any():
+        try:
+            inv[ok] = np.linalg.inv(blk[ok])
+        except np.linalg.LinAlgError:
+            pass
+    return inv
+
+
 def face_schwarz_preconditioner(mesh: TriangleMesh, A, phi=None, free=None):
     """Additive Schwarz preconditioner over faces for the HHJ matrix A.
 
@@ -194,13 +220,13 @@ def face_schwarz_preconditioner(mesh: TriangleMesh, A, phi=None, free=None):
         blk[fixed_loc[:, :, None] | fixed_loc[:, None, :]] = 0.0
         fl = np.flatnonzero(fixed_loc.ravel())
         blk.reshape(-1, 3)[fl, np.tile(idx, len(FE))[fl]] = 1.0
-        inv = np.linalg.inv(blk)
+        inv = _guarded_block_inverse(blk)
         inv[fixed_loc[:, :, None] | fixed_loc[:, None, :]] = 0.0
         new_index = np.cumsum(free) - 1
         FE = np.where(free[FE], new_index[FE], 0)
         n = int(free.sum())
     else:
-        inv = np.linalg.inv(blk)
+        inv = _guarded_block_inverse(blk)
         n = mesh.n_edges
     rows = np.broadcast_to(FE[:, :, None], inv.shape)
     cols = np.broadcast_to(FE[:, None, :], inv.shape)

@@ -19,18 +19,57 @@ Input checks raise ``TypeError`` (wrong kind of array) or ``ValueError`` (bad
 values), each naming the problem and the first offending index.  Unreferenced
 vertices are allowed; per-vertex outputs of the library give them NaN (see the
 individual functions).
+
+Numerical-robustness policy (one set of limits for every solver)
+-----------------------------------------------------------------
+* A face is rejected as degenerate when ``2|T| ≤ DEGENERATE_AREA_RTOL ×
+  (longest edge)²`` with ``DEGENERATE_AREA_RTOL = 1e-7``.  libigl's operators
+  (``igl.cotmatrix``, ``igl.massmatrix``, used by the biharmonic solver, the
+  baselines and the Regge layer) compute areas from edge lengths, whose
+  relative error grows like ``ε/r²`` for a face of relative area ``r``: at
+  ``r = 1e-7`` a cotangent weight is still good to ~1 %, at ``r = 1e-8`` it is
+  off by ~100 % and below ``3e-9`` it is NaN (``tests/test_mesh.py::
+  test_threshold_matches_libigl_precision`` measures this).
+* Coordinates are bounded by ``COORDINATE_MAX = 1e75`` and the longest edge must
+  be at least ``MIN_MESH_SIZE = 1e-60``: beyond that, squared areas in the
+  solvers overflow or underflow float64 (measured: the PCG solve returns NaN
+  at coordinates 1e78).  Curvature scales as 1/length, so rescale such meshes.
+* Vertices whose incident faces' area-weighted normals cancel (two-sided or
+  folded sheets, a flat closed "pillow" of two coincident fans, bow-ties with
+  opposite wings) have no tangent plane: per-vertex outputs are NaN there and
+  they are listed in ``bad_vertices`` (:func:`mark_bad_vertices`).
+* :class:`TriangleMesh` holds read-only copies of ``V`` and ``F``: the arrays
+  cannot change after validation.
 """
 from __future__ import annotations
 
 from functools import cached_property
 
+import warnings
+
 import numpy as np
 
-__all__ = ["TriangleMesh", "validate_mesh", "as_mesh"]
+__all__ = ["TriangleMesh", "validate_mesh", "as_mesh", "mark_bad_vertices", "MeshWarning",
+           "DEGENERATE_AREA_RTOL", "COORDINATE_MAX", "MIN_MESH_SIZE"]
 
-# A face whose area is below this fraction of its squared longest edge is
-# treated as degenerate (its smallest angle is below ~1e-12 rad).
-DEGENERATE_AREA_RTOL = 1e-12
+DEGENERATE_AREA_RTOL = 1e-7
+"""A face with ``2|T| ≤ DEGENERATE_AREA_RTOL × (longest edge)²`` (smallest angle
+below ~1e-7 rad) is rejected: libigl's edge-length formulas lose all accuracy
+about a decade below (module docstring)."""
+
+COORDINATE_MAX = 1e75
+"""Largest accepted ``|coordinate|`` (squared areas overflow float64 beyond ~1e77)."""
+
+MIN_MESH_SIZE = 1e-60
+"""Smallest accepted longest edge (squared areas underflow towards subnormals below)."""
+
+FOLDED_NORMAL_RTOL = float(np.sqrt(np.finfo(np.float64).eps))
+"""A vertex has no tangent plane when ``|Σ_T |T| ν_T| ≤ FOLDED_NORMAL_RTOL Σ_T |T|``
+(the normalised direction would carry less than half the digits of float64)."""
+
+
+class MeshWarning(UserWarning):
+    """An accepted mesh that will probably not give what the user expects (e.g. unwelded)."""
 
 
 def zero_area_faces(edge_vectors, double_areas):
@@ -42,11 +81,13 @@ def zero_area_faces(edge_vectors, double_areas):
     double_areas : (#F,) twice the face areas
 
     A face is degenerate when ``double_area ≤ DEGENERATE_AREA_RTOL × (longest
-    edge)²`` (NaN areas count as degenerate).  The one criterion behind
+    edge)²`` (NaN or overflowed areas count as degenerate).  The one criterion behind
     :class:`TriangleMesh`'s check and ``igl-hhj info``'s count.
     """
-    l2max = (np.asarray(edge_vectors) ** 2).sum(axis=2).max(axis=1)
-    return ~(np.asarray(double_areas) > DEGENERATE_AREA_RTOL * l2max)
+    with np.errstate(over="ignore", invalid="ignore"):
+        l2max = (np.asarray(edge_vectors) ** 2).sum(axis=2).max(axis=1)
+        dbl = np.asarray(double_areas)
+        return ~((dbl > DEGENERATE_AREA_RTOL * l2max) & np.isfinite(dbl) & np.isfinite(l2max))
 
 
 def _as_array(x, name):
@@ -70,6 +111,8 @@ def validate_vertices(V, name="V"):
     V : (#V, 3) float64 C-contiguous numpy array (a copy if conversion was needed)
     """
     V = _as_array(V, name)
+    if V.size == 0:
+        raise ValueError(f"{name} is empty: the mesh has no vertices")
     if V.dtype == object or not (np.issubdtype(V.dtype, np.floating)
                                  or np.issubdtype(V.dtype, np.integer)):
         raise TypeError(f"{name} must hold real numbers, got dtype {V.dtype}")
@@ -82,6 +125,12 @@ def validate_vertices(V, name="V"):
     if not finite.all():
         i = int(np.flatnonzero(~finite)[0])
         raise ValueError(f"{name} has NaN or inf coordinates; first at vertex {i}: {V[i]}")
+    big = (np.abs(V) > COORDINATE_MAX).any(axis=1)
+    if big.any():
+        i = int(np.flatnonzero(big)[0])
+        raise ValueError(f"{name} has coordinates beyond {COORDINATE_MAX:g} (squared areas would "
+                         f"overflow float64); first at vertex {i}: {V[i]}. Rescale the mesh "
+                         f"(curvature scales as 1/length: compute on V / s, divide the result by s)")
     return V
 
 
@@ -93,17 +142,24 @@ def validate_faces(F, nV, name="F"):
     F : (#F, 3) int64 C-contiguous numpy array
     """
     F = _as_array(F, name)
+    if F.size == 0:
+        raise ValueError(f"{name} is empty: the mesh has no faces")
     if F.dtype == bool or not np.issubdtype(F.dtype, np.integer):
         raise TypeError(f"{name} must hold integer vertex indices, got dtype {F.dtype}")
     if F.ndim != 2 or F.shape[1] != 3:
         raise ValueError(f"{name} must have shape (#F, 3) (triangles), got shape {F.shape}")
-    if F.shape[0] == 0:
-        raise ValueError(f"{name} is empty: the mesh has no faces")
+    if np.issubdtype(F.dtype, np.unsignedinteger):
+        bad = (F >= nV).any(axis=1)       # before the int64 cast (uint64 max would wrap to -1)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise ValueError(f"{name} has out-of-range vertex indices (#V = {nV}); "
+                             f"first at face {i}: {F[i].tolist()}")
     F = np.ascontiguousarray(F, dtype=np.int64)
     bad = (F < 0).any(axis=1)
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"{name} has negative vertex indices; first at face {i}: {F[i]}")
+        raise ValueError(f"{name} has negative vertex indices; first at face {i}: {F[i]} "
+                         f"(indices are 0-based positions in V)")
     bad = (F >= nV).any(axis=1)
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
@@ -136,17 +192,31 @@ class TriangleMesh:
     TypeError
         Non-numeric ``V`` or non-integer ``F``.
     ValueError
-        Wrong shapes, empty mesh, NaN/inf coordinates, negative or
-        out-of-range indices, repeated vertices in a face, zero-area faces,
+        Wrong shapes, empty mesh, NaN/inf coordinates or coordinates beyond
+        :data:`COORDINATE_MAX`, a mesh smaller than :data:`MIN_MESH_SIZE`,
+        negative or out-of-range indices, repeated vertices in a face,
+        degenerate faces (relative area ≤ :data:`DEGENERATE_AREA_RTOL`),
         non-manifold edges (more than two faces) or inconsistently oriented
         neighbouring faces.
+
+    Warns
+    -----
+    MeshWarning
+        Boundary vertices that coincide exactly with other boundary vertices
+        (an unwelded mesh or triangle soup: its seams count as boundary).
     """
 
     def __init__(self, V, F):
-        self.V = validate_vertices(V)
-        self.F = validate_faces(F, self.V.shape[0])
+        V = validate_vertices(V)
+        F = validate_faces(F, V.shape[0])
+        # read-only copies: nothing can change the arrays after validation
+        self.V = np.array(V, dtype=np.float64, order="C")
+        self.F = np.array(F, dtype=np.int64, order="C")
+        self.V.setflags(write=False)
+        self.F.setflags(write=False)
         self._check_degenerate()
         self._check_manifold_and_orientation()
+        self._warn_unwelded()
 
     # ------------------------------------------------------------------ sizes
     @property
@@ -311,13 +381,27 @@ class TriangleMesh:
     def vertex_normals(self):
         """(#V, 3) float64: area-weighted unit vertex normals (``igl.per_vertex_normals``).
 
-        Rows of unreferenced vertices are NaN."""
+        Rows of unreferenced vertices and of :attr:`folded_vertices` are NaN."""
         import igl
         N = igl.per_vertex_normals(self.V, self.F,
                                    igl.PerVertexNormalsWeightingType.PER_VERTEX_NORMALS_WEIGHTING_TYPE_AREA)
         N = np.array(N, dtype=np.float64)
-        N[~self.referenced_vertices] = np.nan
+        N[~self.referenced_vertices | self.folded_vertices] = np.nan
         return N
+
+    @cached_property
+    def folded_vertices(self):
+        """(#V,) bool: referenced vertices without a tangent plane.
+
+        ``|Σ_T |T| ν_T| ≤ FOLDED_NORMAL_RTOL Σ_T |T|`` over the incident faces:
+        their normals cancel, as on a two-sided sheet (a triangle and its
+        reverse), a sheet folded onto itself, the rim of a flat closed disc
+        made of two fans, or a bow-tie vertex with opposite wings."""
+        corners = np.broadcast_to(self._cross[:, None, :], (self.n_faces, 3, 3))
+        s = np.linalg.norm(self.sum_corners_to_vertices(corners), axis=1)
+        a = self.sum_corners_to_vertices(np.broadcast_to(self.face_double_areas[:, None],
+                                                         (self.n_faces, 3)))
+        return self.referenced_vertices & (s <= FOLDED_NORMAL_RTOL * a)
 
     def sum_corners_to_vertices(self, values):
         """Scatter-add per-corner values to the vertices.
@@ -342,14 +426,34 @@ class TriangleMesh:
 
     # ------------------------------------------------------------ checks
     def _check_degenerate(self):
-        dbl = self.face_double_areas
-        bad = zero_area_faces(self._edge_vectors, dbl)
+        with np.errstate(over="ignore", invalid="ignore"):
+            dbl = self.face_double_areas
+            bad = zero_area_faces(self._edge_vectors, dbl)
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
-            longest = np.sqrt((self._edge_vectors[i] ** 2).sum(axis=1).max())
+            n = int(bad.sum())
+            many = f" ({n} such faces)" if n > 1 else ""
+            with np.errstate(over="ignore", invalid="ignore"):
+                longest = float(np.sqrt((self._edge_vectors[i] ** 2).sum(axis=1).max()))
+            area = 0.5 * float(dbl[i])
+            if not (np.isfinite(area) and np.isfinite(longest)):
+                raise ValueError(
+                    f"F has faces whose area overflows float64; first at face {i}: {self.F[i]}"
+                    f"{many}. Rescale the mesh (curvature scales as 1/length)")
+            if area == 0.0:
+                raise ValueError(
+                    f"F has degenerate (zero-area) faces; first at face {i}: {self.F[i]}{many} "
+                    f"(collinear corners, longest edge {longest:.3g}): remove or collapse them")
             raise ValueError(
-                f"F has degenerate (zero-area) faces; first at face {i}: {self.F[i]} "
-                f"(area {0.5 * dbl[i]:.3g}, longest edge {longest:.3g})")
+                f"F has near-degenerate (sliver) faces; first at face {i}: {self.F[i]}{many} "
+                f"(area {area:.3g}, longest edge {longest:.3g}: relative area "
+                f"{2 * area / longest ** 2:.2g} ≤ {DEGENERATE_AREA_RTOL:g}, below what libigl's "
+                f"edge-length formulas resolve): collapse the short edge or remove the sliver")
+        h = float(np.sqrt((self._edge_vectors ** 2).sum(axis=2).max()))
+        if h < MIN_MESH_SIZE:
+            raise ValueError(f"the mesh is too small: its longest edge is {h:.3g} < "
+                             f"{MIN_MESH_SIZE:g} (squared areas underflow float64). Rescale it "
+                             f"(curvature scales as 1/length: compute on s V, multiply by s)")
 
     def _check_manifold_and_orientation(self):
         count = self.edge_face_count
@@ -369,7 +473,26 @@ class TriangleMesh:
             f = np.flatnonzero((self.face_edges == e).any(axis=1))
             raise ValueError(
                 f"mesh is not consistently oriented: faces {f.tolist()} traverse edge {e} "
-                f"(vertices {self.edges[e].tolist()}) in the same direction")
+                f"(vertices {self.edges[e].tolist()}) in the same direction; orient it with "
+                f"igl.bfs_orient(F) (a non-orientable surface such as a Möbius band cannot be)")
+
+    def _warn_unwelded(self):
+        """Warn when boundary vertices coincide (a triangle soup or split seams)."""
+        if not self.has_boundary:
+            return
+        b = np.flatnonzero(self.boundary_vertices)
+        _, inv, cnt = np.unique(self.V[b], axis=0, return_inverse=True, return_counts=True)
+        dup = cnt[inv.ravel()] > 1
+        if dup.any():
+            soup = bool(self.boundary_edges.all()) and self.n_faces > 1
+            what = ("a triangle soup: no two faces share an edge, so every face is curvature-free "
+                    "(the results are zeros)" if soup else
+                    "unwelded: its seams count as boundary and the curvature there is wrong")
+            warnings.warn(
+                f"{int(dup.sum())} boundary vertices coincide with other vertices (first "
+                f"{int(b[dup][0])}): the mesh looks {what}; weld it first, e.g. "
+                f"V, _, J = igl.remove_duplicate_vertices(V, 0.0); F = J[F]", MeshWarning,
+                stacklevel=3)
 
 
 def as_mesh(V, F=None):
@@ -392,12 +515,39 @@ def as_mesh(V, F=None):
 
 
 def validate_mesh(V, F):
-    """Validate ``(V, F)`` and return them as float64 / int64 C-contiguous copies.
+    """Validate ``(V, F)`` and return them as float64 / int64 C-contiguous (writable) copies.
 
     Raises the same errors as :class:`TriangleMesh`.
     """
     m = TriangleMesh(V, F)
-    return m.V, m.F
+    return m.V.copy(), m.F.copy()
+
+
+def mark_bad_vertices(mesh, *arrays):
+    """Set the rows of per-vertex outputs without a value to NaN and list them.
+
+    A vertex is *bad* when it is unreferenced, has no tangent plane
+    (:attr:`TriangleMesh.folded_vertices`: two-sided or folded sheets), or any
+    of ``arrays`` is non-finite in its row.  Every NaN row of the result is
+    listed, and every listed row is NaN in every array.
+
+    Parameters
+    ----------
+    mesh : TriangleMesh
+    *arrays : (#V, ...) float arrays
+
+    Returns
+    -------
+    (*arrays, bad) : float64 copies of the arrays with NaN rows, and ``bad``
+        the sorted list of bad vertex indices (``int``).
+    """
+    out = [np.array(a, dtype=np.float64) for a in arrays]
+    bad = ~mesh.referenced_vertices | mesh.folded_vertices
+    for a in out:
+        bad |= ~np.isfinite(a.reshape(len(a), -1)).all(axis=1)
+    for a in out:
+        a[bad] = np.nan
+    return (*out, np.flatnonzero(bad).tolist())
 
 
 def per_vertex_array(mesh, values, name, shape_tail=()):

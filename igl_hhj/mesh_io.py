@@ -14,11 +14,22 @@ bad inputs instead of raising (measured with libigl 2.6.3):
 * an ``.off`` header declaring 10⁸ vertices: 5.5 GB of memory, 15 s;
 * a truncated binary ``.ply``: uninitialised memory returned as face indices.
 
+* an ``.off`` face line claiming 2·10⁹ corners in a 45-byte file: 15.7 GB
+  of memory, then ``std::bad_alloc``;
+* an ascii ``.ply`` with a non-numeric token: uninitialised indices;
+* ``.obj`` faces written 0-based: index -1 after libigl's 1-based shift.
+
 :func:`read_mesh` therefore checks existence, regular file, readability and
-extension, compares the element counts an ``.off`` / ``.ply`` header declares
-with the file size (and, for ``.ply``, that every face is a triangle), reads
-with libigl's C++ messages captured, and raises :class:`MeshFileError` (a
-``ValueError``) with one line naming the problem.
+extension, then checks *every* count and token of the body before libigl
+sees it, with numpy in bounded chunks (memory O(#lines), time linear in the
+file size): the element counts an ``.off`` / ``.ply`` header declares against
+the lines or bytes that follow, every corner count of an ``.off`` face line
+against the indices it lists, that every ascii token that must be a number is
+one, ``.obj`` faces 1-based, binary ``.ply`` face records triangles, binary
+``.stl`` sizes ``84 + 50 × count``, ``.mesh`` / ``.msh`` section counts
+against the lines that follow.  It reads with libigl's C++ messages captured
+and raises :class:`MeshFileError` (a ``ValueError``) with one line naming the
+problem.
 
 :func:`write_curvature` writes a
 :class:`igl_hhj.baselines.CurvatureEstimate` as ``.npz``, ``.csv``, ``.ply``
@@ -52,6 +63,7 @@ CURVATURE_COLUMNS = ("k1", "k2", "H", "K", "d1x", "d1y", "d1z", "d2x", "d2y", "d
 """Per-element columns of the ``.csv`` and ``.ply`` outputs (after ``index`` in the csv)."""
 
 _HEADER_BYTES = 1 << 16
+_PLY_HEADER_MAX = 1 << 26           # a PLY header may be long (comments), not unbounded
 _PLY_SIZES = {"char": 1, "int8": 1, "uchar": 1, "uint8": 1, "short": 2, "int16": 2,
               "ushort": 2, "uint16": 2, "int": 4, "int32": 4, "uint": 4, "uint32": 4,
               "float": 4, "float32": 4, "double": 8, "float64": 8}
@@ -89,6 +101,255 @@ def _too_short(path, what, need, have):
                         f"at least {need} bytes after the header, but the file has {have}")
 
 
+# --------------------------------------------------------------------------- body scan
+_CHUNK = 1 << 22          # bytes of the file per vectorised pass (bounds temporary memory)
+
+
+def _char_table(chars):
+    t = np.zeros(256, dtype=bool)
+    t[list(chars)] = True
+    return t
+
+
+_WS = _char_table(b" \t\r\n\v\f")
+_NUMBER = _char_table(b"0123456789+-.eE")
+_DIGIT = _char_table(b"0123456789")
+_CORNER = _char_table(b"0123456789-/")
+
+
+class _Lines:
+    """A text body summarised per non-empty line, with numpy in bounded chunks.
+
+    Memory is O(number of lines) plus O(``_CHUNK``); time is linear in the
+    file size.  Everything after ``#`` on a line is a comment (``comments``).
+
+    Attributes (arrays, one entry per non-empty line in file order)
+    ----------
+    offset : byte offset of the line in the file
+    lineno : 1-based line number in the file
+    ntok : number of whitespace-separated tokens
+    c0, flen : first byte and length of the first token
+    first : value of the first token if it is an integer of ≤ 18 digits, else -1
+    n_num : how many tokens are numbers (float syntax)
+    n_corner : how many tokens are OBJ face corners (``i``, ``i/j``, ``i//k``, ``-i``)
+    zero_corner : one of those corners contains the index 0
+    int_k : how many of tokens 2 .. 1 + first are non-negative integers (OFF face lines)
+    """
+
+    FIELDS = ("offset", "lineno", "ntok", "c0", "flen", "first", "n_num", "n_corner",
+              "zero_corner", "int_k")
+
+    def __init__(self, path, start, comments=True, first_line=1, corners=False):
+        parts = {k: [] for k in self.FIELDS}
+        line0, pos0 = first_line, start
+        with open(path, "rb") as fh:
+            fh.seek(start)
+            carry = b""
+            while True:
+                block = fh.read(_CHUNK)
+                data = carry + block
+                if block:
+                    cut = data.rfind(b"\n") + 1
+                    if cut == 0:
+                        carry = data
+                        continue
+                    data, carry = data[:cut], data[cut:]
+                if data:
+                    for k, v in self._scan(data, comments, corners).items():
+                        parts[k].append(v)
+                    parts["lineno"][-1] += line0
+                    parts["offset"][-1] += pos0
+                    line0 += data.count(b"\n")
+                    pos0 += len(data)
+                if not block:
+                    break
+        for k, v in parts.items():
+            setattr(self, k, np.concatenate(v) if v else np.zeros(0, dtype=np.int64))
+
+    def __len__(self):
+        return len(self.ntok)
+
+    @staticmethod
+    def _scan(data, comments, corners):
+        buf = np.frombuffer(data, dtype=np.uint8)
+        n = buf.size
+        space = _WS[buf]
+        nl = np.flatnonzero(buf == 10)
+        if comments and b"#" in data:
+            hashes = np.flatnonzero(buf == 35)
+            ends = np.append(nl, n)[np.searchsorted(nl, hashes)]     # end of each comment
+            delta = np.zeros(n + 1, dtype=np.int32)
+            np.add.at(delta, hashes, 1)
+            np.add.at(delta, ends, -1)
+            space |= np.cumsum(delta[:n]) > 0
+        inside = ~space
+        before = np.empty(n, dtype=bool)                            # previous char is space
+        before[0] = True
+        before[1:] = space[:-1]
+        s = np.flatnonzero(inside & before)                         # token starts
+        before[:-1] = space[1:]                                     # (reused: next char is space)
+        before[-1] = True
+        e = np.flatnonzero(inside & before) + 1                     # token ends (exclusive)
+        del before
+        line = np.searchsorted(nl, s)                               # line of each token (block)
+        head = np.flatnonzero(np.concatenate([[True], line[1:] != line[:-1]])) if s.size \
+            else np.zeros(0, dtype=np.int64)
+        ntok = np.diff(np.append(head, s.size))
+        owner = np.repeat(np.arange(head.size), ntok)               # line (table row) of each token
+        pos = np.arange(s.size) - head[owner] if s.size else np.zeros(0, dtype=np.int64)
+        starts = np.concatenate([[0], nl + 1])[line[head]] if head.size else head
+
+        pre = np.empty(n + 1, dtype=np.int32)                       # n ≤ 2 × _CHUNK < 2³¹
+        pre[0] = 0
+
+        def count(mask):                                            # per token: chars in mask
+            np.cumsum(mask & inside, dtype=np.int32, out=pre[1:])
+            return pre[e] - pre[s]
+
+        def every(table):                                           # every character of the token
+            return count(~table[buf]) == 0
+
+        has_digit = count(_DIGIT[buf]) > 0
+        digits = every(_DIGIT)
+        number = every(_NUMBER) & has_digit
+        corner = np.zeros(s.size, dtype=bool)
+        zero = np.zeros(s.size, dtype=bool)
+        if corners:                                                 # OBJ face corners
+            corner = every(_CORNER) & has_digit
+            zc = np.flatnonzero(buf == 48)                          # a component "0" of a corner
+            before = np.where(zc > 0, buf[np.maximum(zc - 1, 0)], 32)
+            after = np.where(zc < n - 1, buf[np.minimum(zc + 1, n - 1)], 32)
+            zc = zc[((before == 47) | _WS[before]) & ((after == 47) | _WS[after])]
+            if zc.size and s.size:
+                t = np.searchsorted(s, zc, side="right") - 1
+                zero[t[(t >= 0) & (zc < e[np.maximum(t, 0)])]] = True
+        fs, flen = s[head], (e - s)[head]
+        first = np.where(digits[head] & (flen <= 18), 0, -1).astype(np.int64)
+        for j in range(18):
+            m = (first >= 0) & (j < flen)
+            first[m] = first[m] * 10 + (buf[fs[m] + j].astype(np.int64) - 48)
+        kk = first[owner] if s.size else pos
+
+        def per_line(x):
+            return np.bincount(owner, weights=x, minlength=head.size).astype(np.int64)
+
+        return {"offset": starts.astype(np.int64), "lineno": line[head].astype(np.int64),
+                "ntok": ntok.astype(np.int64), "c0": buf[fs].astype(np.int64),
+                "flen": flen.astype(np.int64), "first": first,
+                "n_num": per_line(number), "n_corner": per_line(corner),
+                "zero_corner": per_line(corner & zero) > 0,
+                "int_k": per_line((pos > 0) & (pos <= kk) & digits)}
+
+    def text(self, path, i, limit=60):
+        """The i-th non-empty line (at most ``limit`` characters), for messages."""
+        with open(path, "rb") as fh:
+            fh.seek(int(self.offset[i]))
+            raw = fh.readline(limit + 1).rstrip(b"\r\n")
+        txt = raw[:limit].decode("ascii", "replace")
+        return txt + ("..." if len(raw) > limit else "")
+
+
+def _first_bad(path, lines, bad, what):
+    """Raise MeshFileError naming the first line where ``bad`` holds."""
+    i = int(np.flatnonzero(bad)[0])
+    n = int(bad.sum())
+    more = f" ({n} such lines)" if n > 1 else ""
+    raise MeshFileError(f"{path}: line {int(lines.lineno[i])}: {what}{more}: "
+                        f"{lines.text(path, i)!r}")
+
+
+def _check_off_body(path, nV, nF):
+    """Every vertex line numeric, every face line a polygon whose corner count its
+    indices back up (libigl allocates whatever a face line claims)."""
+    L = _Lines(path, 0)
+    h = 1 if L.ntok[0] >= 3 else 2                 # counts on the OFF line or the next one
+    if len(L) < h + nV + nF:
+        raise MeshFileError(f"{path}: truncated: the header declares {nV} vertices and {nF} "
+                            f"faces, the file has {max(len(L) - h, 0)} lines after it")
+    v = slice(h, h + nV)
+    _check_rows(path, L, v, (L.ntok[v] < 3) | (L.n_num[v] != L.ntok[v]),
+                "vertex line is not three (or more) numbers")
+    f = slice(h + nV, h + nV + nF)
+    k = L.first[f]
+    _check_rows(path, L, f, k < 0, "face line does not start with its corner count")
+    _check_rows(path, L, f, k < 3, "face with fewer than 3 corners")
+    _check_rows(path, L, f, L.ntok[f] < 1 + k,
+                "face line claims more corners than it lists (truncated or corrupt)")
+    _check_rows(path, L, f, L.int_k[f] != k, "face corner is not a non-negative integer index")
+
+
+def _check_rows(path, L, rows, bad, what):
+    if bad.any():
+        mask = np.zeros(len(L), dtype=bool)
+        mask[rows] = bad
+        _first_bad(path, L, mask, what)
+
+
+def _check_obj(path):
+    """``v`` lines numeric, ``f`` lines made of corner indices, and 1-based."""
+    L = _Lines(path, 0, corners=True)
+    one = L.flen == 1
+    v = one & (L.c0 == ord("v"))
+    f = one & (L.c0 == ord("f"))
+    bad = v & ((L.ntok < 4) | (L.n_num != L.ntok - 1))
+    if bad.any():
+        _first_bad(path, L, bad, "vertex line is not 'v' and three (or more) numbers")
+    bad = f & ((L.ntok < 4) | (L.n_corner != L.ntok - 1))
+    if bad.any():
+        _first_bad(path, L, bad, "face line is not 'f' and three or more vertex indices "
+                                 "(i, i/t, i/t/n or i//n)")
+    bad = f & L.zero_corner
+    if bad.any():
+        _first_bad(path, L, bad, "face uses vertex index 0, but OBJ indices start at 1: the file "
+                                 "is 0-based (add 1 to every face index, or write it with a "
+                                 "1-based OBJ writer)")
+
+
+def _check_stl(path, head, size):
+    """Binary STL: 84 + 50 × count bytes exactly; ascii STL: numeric vertex lines."""
+    if size >= 84:
+        n = int(np.frombuffer(head[80:84], dtype="<u4")[0]) if len(head) >= 84 else -1
+        if n >= 0 and 84 + 50 * n == size:
+            if n == 0:
+                raise MeshFileError(f"{path}: binary STL with 0 triangles")
+            return
+    if not head.lstrip().lower().startswith(b"solid"):
+        n = int(np.frombuffer(head[80:84], dtype="<u4")[0]) if len(head) >= 84 else 0
+        raise MeshFileError(f"{path}: not an STL file: a binary STL declaring {n} triangles needs "
+                            f"{84 + 50 * n} bytes, the file has {size}, and it does not start "
+                            f"with 'solid' (ascii STL)")
+    L = _Lines(path, 0)
+    vert = (L.c0 == ord("v")) & (L.flen == 6)
+    bad = vert & ((L.ntok != 4) | (L.n_num != 3))
+    if bad.any():
+        _first_bad(path, L, bad, "vertex line is not 'vertex' and three numbers")
+    nv = int(vert.sum())
+    if nv == 0 or nv % 3:
+        raise MeshFileError(f"{path}: ascii STL with {nv} vertex lines (need a positive multiple "
+                            f"of 3: three per facet); truncated or corrupt")
+
+
+def _check_keyword_counts(path, size):
+    """.mesh / .msh: a count after a section keyword (``Vertices``, ``$Nodes``, ...) must
+    not exceed the lines that follow (libigl allocates what the count says)."""
+    L = _Lines(path, 0)
+    letter = ((L.c0 | 32) >= ord("a")) & ((L.c0 | 32) <= ord("z")) | (L.c0 == ord("$"))
+    kw = np.flatnonzero(letter & (L.first < 0) & (L.ntok <= 2))
+    for i in kw[:200]:                                  # section keywords: a handful
+        if L.ntok[i] == 2:
+            words = L.text(path, i, 200).split()
+            n = int(words[1]) if len(words) > 1 and words[1].isdigit() else -1
+            rest = len(L) - i - 1
+        elif i + 1 < len(L) and L.ntok[i + 1] >= 1:
+            n, rest = int(L.first[i + 1]), len(L) - i - 2
+        else:
+            continue
+        if n > max(rest, 0) + 1:
+            raise MeshFileError(f"{path}: line {int(L.lineno[i])}: section "
+                                f"{L.text(path, i, 30)!r} declares {n} records, the file has "
+                                f"{max(rest, 0)} more lines (truncated or corrupt)")
+
+
 def _check_off_header(path, head, size):
     """Declared ``nV nF`` of an ascii OFF against the file size (≥ 6 bytes a vertex, 8 a face)."""
     lines = [ln.split(b"#")[0].split() for ln in head.split(b"\n")[:64]]
@@ -108,13 +369,32 @@ def _check_off_header(path, head, size):
     need = 6 * nV + 8 * nF - 1          # "0 0 0\n" per vertex, "3 0 1 2\n" per face
     if need > size:
         _too_short(path, f"{nV} vertices and {nF} faces", need, size)
+    _check_off_body(path, nV, nF)
+
+
+def _ply_head(path, head):
+    """The file's first bytes up to and including the line of ``end_header`` (any length
+    up to ``_PLY_HEADER_MAX``)."""
+    if not head.startswith(b"ply"):
+        raise MeshFileError(f"{path}: not a PLY file (it does not start with 'ply')")
+    if b"end_header" in head:
+        return head
+    with open(path, "rb") as fh:
+        data = b""
+        while len(data) < _PLY_HEADER_MAX:
+            block = fh.read(1 << 20)
+            if not block:
+                break
+            data += block
+            if data.find(b"end_header", max(len(data) - len(block) - 16, 0)) >= 0:
+                return data
+    raise MeshFileError(f"{path}: not a PLY file (no 'end_header' line in the first "
+                        f"{min(len(data), _PLY_HEADER_MAX)} bytes)")
 
 
 def _parse_ply_header(path, head):
+    head = _ply_head(path, head)
     end = head.find(b"end_header")
-    if not head.startswith(b"ply") or end < 0:
-        raise MeshFileError(f"{path}: not a PLY file (no 'ply' ... 'end_header' header "
-                            f"in the first {_HEADER_BYTES} bytes)")
     body_start = head.index(b"\n", end) + 1 if b"\n" in head[end:] else len(head)
     fmt, elements = None, []
     for raw in head[:end].split(b"\n")[1:]:
@@ -134,7 +414,30 @@ def _parse_ply_header(path, head):
         raise MeshFileError(f"{path}: unknown PLY format {fmt!r}")
     if any(n < 0 for _, n, _ in elements):
         raise MeshFileError(f"{path}: corrupt PLY header: negative element count")
+    _check_ply_properties(path, elements)
     return fmt, elements, body_start
+
+
+_PLY_INT_TYPES = ("char", "int8", "uchar", "uint8", "short", "int16", "ushort", "uint16", "int",
+                  "int32", "uint", "uint32")
+
+
+def _check_ply_properties(path, elements):
+    """Known property types, vertex x/y/z and face vertex_indices (libigl's PLY reader
+    segfaults when they are missing)."""
+    for name, _, props in elements:
+        for pname, types in props:
+            scalar = types[1:] if types and types[0] == "list" else types
+            if not scalar or any(t not in _PLY_SIZES for t in scalar) or                     (types[0] == "list" and (len(types) != 3 or types[1] not in _PLY_INT_TYPES)):
+                raise MeshFileError(f"{path}: corrupt PLY header: property {pname!r} of element "
+                                    f"{name!r} has unknown type {' '.join(types)!r}")
+    named = {name: props for name, _, props in elements}
+    if "vertex" not in named or not {"x", "y", "z"} <= {p for p, t in named["vertex"] if t[0] != "list"}:
+        raise MeshFileError(f"{path}: PLY header has no 'element vertex' with properties x, y, z")
+    if "face" not in named or not any(p in ("vertex_indices", "vertex_index") and t[0] == "list"
+                                      and t[2] in _PLY_INT_TYPES for p, t in named["face"]):
+        raise MeshFileError(f"{path}: PLY header has no 'element face' with an integer list "
+                            f"property vertex_indices")
 
 
 def _check_ply(path, head, size):
@@ -162,31 +465,68 @@ def _check_ply(path, head, size):
                 f"{path}: truncated or not a triangle mesh: the header declares {what}, "
                 f"a triangle mesh with those needs {need} body bytes, the file has {body} "
                 f"(libigl's PLY reader crashes or returns garbage on such files)")
+        if exact:
+            _check_binary_ply_faces(path, fmt, elements, body_start)
         return
-    # ascii: one line per element; check the count first (bounded memory), then the faces
+    # ascii: one line per element; check the count first (bounded memory), then the lines
     total = sum(counts.values())
     if 2 * total - 1 > body:
         _too_short(path, what, 2 * total - 1, body)
     with open(path, "rb") as fh:
-        fh.seek(body_start)
-        lines = np.array(fh.read().split(b"\n"))
-    lines = lines[np.char.str_len(np.char.strip(lines)) > 0]
-    if len(lines) != total:
+        n_head = fh.read(body_start).count(b"\n")
+    L = _Lines(path, body_start, comments=False, first_line=n_head + 1)
+    if len(L) != total:
         raise MeshFileError(f"{path}: truncated or corrupt: the header declares {what} "
-                            f"({total} lines) but the body has {len(lines)} lines "
+                            f"({total} lines) but the body has {len(L)} lines "
                             f"(libigl's PLY reader aborts on such files)")
+    if (L.n_num != L.ntok).any():
+        _first_bad(path, L, L.n_num != L.ntok, "non-numeric value in the body of an ascii PLY")
     start = 0
-    for name, n, _ in elements:
+    for name, n, props in elements:
+        rows = slice(start, start + n)
+        lists = [p for p, types in props if types[0] == "list"]
         if name == "face" and n:
-            face_lines = np.char.strip(np.char.replace(lines[start:start + n], b"\t", b" "))
-            first = np.char.partition(face_lines, b" ")[:, 0]
-            bad = np.flatnonzero(first != b"3")
-            if bad.size:
-                k = first[bad[0]].decode(errors="replace")
-                raise MeshFileError(f"{path}: face {int(bad[0])} has {k} "
-                                    f"vertices: only triangle meshes are supported "
-                                    f"(libigl's PLY reader aborts on mixed polygons)")
+            k = L.first[rows]
+            _check_rows(path, L, rows, k != 3, "face is not a triangle (only triangle meshes are "
+                        "supported: libigl's PLY reader aborts on mixed polygons)")
+            if lists == [p for p, _ in props if p in ("vertex_indices", "vertex_index")]:
+                want = 1 + 3 + (len(props) - len(lists))
+                _check_rows(path, L, rows, L.ntok[rows] != want,
+                            f"face line does not have the {want} values its properties need")
+        elif not lists and n:
+            _check_rows(path, L, rows, L.ntok[rows] != len(props),
+                        f"{name} line does not have the {len(props)} values its properties need")
         start += n
+
+
+def _check_binary_ply_faces(path, fmt, elements, body_start):
+    """Every face record of a binary PLY of known layout must be a triangle (a corrupt
+    count makes libigl read indices out of the following records)."""
+    order = "<" if fmt == "binary_little_endian" else ">"
+    kinds = {1: "u1", 2: "u2", 4: "u4", 8: "u8"}
+    offset = body_start
+    for name, n, props in elements:
+        fields, ok = [], True
+        for k, (pname, types) in enumerate(props):
+            if types[0] == "list":
+                if name != "face" or pname not in ("vertex_indices", "vertex_index"):
+                    ok = False
+                    break
+                fields.append(("count", order + kinds.get(_PLY_SIZES.get(types[1], 1), "u1")))
+                fields.append((f"i{k}", order + kinds.get(_PLY_SIZES.get(types[2], 4), "u4"), (3,)))
+            else:
+                fields.append((f"p{k}", f"V{_PLY_SIZES.get(types[0], 1)}"))
+        if not ok:
+            return
+        dt = np.dtype(fields)
+        if name == "face" and n and "count" in dt.names:
+            rec = np.fromfile(path, dtype=dt, count=n, offset=offset)
+            bad = np.flatnonzero(rec["count"] != 3)
+            if bad.size:
+                raise MeshFileError(f"{path}: face {int(bad[0])} declares {int(rec['count'][bad[0]])} "
+                                    f"corners: corrupt, or not a triangle mesh (only triangle "
+                                    f"meshes are supported)")
+        offset += n * dt.itemsize
 
 
 def _flush_c_stdio():
@@ -268,6 +608,12 @@ def read_mesh(path):
         _check_off_header(path, head, size)
     elif ext == ".ply":
         _check_ply(path, head, size)
+    elif ext == ".obj":
+        _check_obj(path)
+    elif ext == ".stl":
+        _check_stl(path, head, size)
+    elif ext in (".mesh", ".msh"):
+        _check_keyword_counts(path, size)
     import igl
     with CapturedOutput() as cap:
         try:

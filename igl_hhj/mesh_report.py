@@ -101,7 +101,7 @@ class MeshReport:
                                         f"inconsistent ({self.n_misoriented_edges} edges traversed "
                                         f"twice in the same direction)")
                 + {True: ", orientable", False: ", non-orientable", None: ""}[self.orientable],
-                "degenerate faces  " + (f"{self.n_zero_area_faces} zero-area, " if self.n_zero_area_faces
+                "degenerate faces  " + (f"{self.n_zero_area_faces} zero-area or sliver, " if self.n_zero_area_faces
                                         is not None else "zero-area not checked (non-finite coordinates), ")
                 + f"{self.n_repeated_vertex_faces} with a repeated vertex",
                 f"duplicate faces   {self.n_duplicate_faces}",

@@ -85,3 +85,14 @@ def png_stats(path):
     fg = im.min(axis=2) < 0.97
     return {"height": im.shape[0], "width": im.shape[1], "std": float(im.std()), "foreground": float(fg.mean()),
             "red": float(((r > b + 0.15) & fg).mean()), "blue": float(((b > r + 0.15) & fg).mean())}
+
+
+def pytest_terminal_summary(terminalreporter):
+    """Print how many inputs the fuzzers tried (issue 12 asks for the count)."""
+    import sys
+    fuzz = sys.modules.get("test_fuzz")
+    counts = getattr(fuzz, "FUZZ_COUNTS", None)
+    if counts:
+        total = sum(counts.values())
+        detail = ", ".join(f"{k} {v}" for k, v in sorted(counts.items()))
+        terminalreporter.write_line(f"fuzz inputs tried: {total} ({detail})")

@@ -204,7 +204,7 @@ def test_unreferenced_vertex_is_nan_in_every_format(tmp_path, capsys):
     path = write_off(tmp_path / "extra.off", np.vstack([V, [[5.0, 5.0, 5.0]]]), F)
     for ext in (".csv", ".ply"):
         assert cli.main(["curvature", str(path), "-o", str(tmp_path / f"k{ext}")]) == 0
-    assert "1 vertices have no value (NaN): unreferenced" in capsys.readouterr().out
+    assert "1 vertices have no value (NaN): 1 unreferenced" in capsys.readouterr().out
     csv = np.loadtxt(tmp_path / "k.csv", delimiter=",", skiprows=1)
     vert = read_ply_properties(tmp_path / "k.ply")["vertex"]
     assert np.isnan(csv[-1, 1:]).all() and np.isfinite(csv[:-1]).all()
@@ -339,7 +339,7 @@ def test_info_sphere(sphere, capsys):
     assert rows["Euler char."] == "2" and rows["genus"] == "0"
     assert rows["edge-manifold"] == "yes" and rows["vertex-manifold"] == "yes"
     assert rows["orientation"] == "consistent, orientable"
-    assert rows["degenerate faces"] == "0 zero-area, 0 with a repeated vertex"
+    assert rows["degenerate faces"] == "0 zero-area or sliver, 0 with a repeated vertex"
     assert rows["verdict"] == "accepted by igl_hhj"
 
 
@@ -392,7 +392,7 @@ def moebius(n=8, w=0.3):
 
 @pytest.mark.parametrize("mesh, row, value", [
     (NONMANIFOLD, "edge-manifold", "no (1 edges with more than two faces)"),
-    (DEGENERATE, "degenerate faces", "1 zero-area, 0 with a repeated vertex"),
+    (DEGENERATE, "degenerate faces", "1 zero-area or sliver, 0 with a repeated vertex"),
     (FLIPPED, "orientation", "inconsistent (1 edges traversed twice in the same direction), orientable"),
     (moebius(), "genus", "not defined: non-orientable"),
 ], ids=["nonmanifold", "degenerate", "flipped", "moebius"])
@@ -466,7 +466,7 @@ def test_bad_files_give_one_line(tmp_path, capfd, command, name):
     path = tmp_path / name
     if BAD_FILES[name] is not None:
         path.write_bytes(BAD_FILES[name])
-    assert cli.main([command, str(path)]) == 2
+    assert cli.main([command, str(path)]) == cli.EXIT_UNREADABLE
     cap = capfd.readouterr()
     assert str(path) in one_error_line(cap.err)
     assert cap.out == ""
@@ -475,12 +475,12 @@ def test_bad_files_give_one_line(tmp_path, capfd, command, name):
 def test_directory_and_unreadable_file(tmp_path, capsys):
     folder = tmp_path / "folder.off"
     folder.mkdir()
-    assert cli.main(["info", str(folder)]) == 2
+    assert cli.main(["info", str(folder)]) == cli.EXIT_UNREADABLE
     assert "directory" in one_error_line(capsys.readouterr().err)
     if hasattr(os, "geteuid") and os.geteuid() != 0:       # root reads everything
         locked = write_off(tmp_path / "locked.off", *FLIPPED)
         locked.chmod(0)
-        assert cli.main(["curvature", str(locked)]) == 2
+        assert cli.main(["curvature", str(locked)]) == cli.EXIT_UNREADABLE
         assert "cannot read" in one_error_line(capsys.readouterr().err)
 
 

@@ -23,8 +23,8 @@ from __future__ import annotations
 import numpy as np
 
 from .elements import (REF_EDGE_NORMALS, REF_EDGE_TANGENTS, REF_VERTICES, LagrangeSpace,
-                       ReggeMetric, _call_metric, _call_scalar,
-                       _check_int, monomials)
+                       MAX_DEGREE, MAX_QUAD_DEGREE, ReggeMetric, _call_metric, _call_scalar,
+                       _check_finite_values, _check_int, monomials)
 from .quadrature import gauss_legendre, triangle_rule
 
 __all__ = ["metric_gauss_curvature", "edge_geodesic_curvature", "corner_angles",
@@ -161,7 +161,8 @@ def triangle_gauss_bonnet(gh, quad_degree=None):
     """Per element ``∫_T K ω_T + ∮_{∂T} κ_in ω_E + Σ_corners (π - θ)``; equals ``2π``
     up to round-off for any (smooth-in-T) metric.  Returns ``(#F,)``."""
     k = gh.degree
-    qd = quad_degree or _default_quad(k, 1)
+    qd = _default_quad(k, 1) if quad_degree is None else _check_int(
+        quad_degree, "quad_degree", 2 * max(k, 1), MAX_QUAD_DEGREE)
     space = LagrangeSpace(gh.tri, 1)
     load, _ = _element_terms(gh, space, qd)
     return load.sum(axis=1) + 3 * np.pi
@@ -257,7 +258,7 @@ class LiftedCurvature:
         ``-Δw = K̄ - K_h``, ``w = 0`` on ``∂Ω`` (Gopalakrishnan et al. 2024, §4)."""
         import scipy.sparse.linalg as spla
         tri = self.space.tri
-        P = self.degree + 2 if degree is None else _check_int(degree, "degree", 1)
+        P = self.degree + 2 if degree is None else _check_int(degree, "degree", 1, MAX_DEGREE)
         W = LagrangeSpace(tri, P)
         qd = quad_degree or 2 * P + 10
         pts, w = triangle_rule(qd)
@@ -287,8 +288,10 @@ def gauss_curvature_functional(gh, degree=None, quad_degree=None):
     if not isinstance(gh, ReggeMetric):
         raise TypeError(f"g_h must be a ReggeMetric (see igl_hhj.regge.interpolate), "
                         f"got {type(gh).__name__}")
-    p = max(gh.degree, 1) if degree is None else _check_int(degree, "degree", 1)
-    qd = _default_quad(gh.degree, p) if quad_degree is None else _check_int(quad_degree, "quad_degree", 1)
+    p = max(gh.degree, 1) if degree is None else _check_int(degree, "degree", 1, MAX_DEGREE)
+    qd = _default_quad(gh.degree, p) if quad_degree is None else _check_int(
+        quad_degree, "quad_degree", 2 * max(gh.degree, p), MAX_QUAD_DEGREE,
+        " = 2 max(k, p) (the element integrals must be exact for the mass matrix to be SPD)")
     space = LagrangeSpace(gh.tri, p)
     load_loc, Mg = _element_terms(gh, space, qd)
     load = space.assemble_vector(load_loc)
@@ -383,6 +386,7 @@ def lift_gauss_curvature(g_h, degree=None, *, dirichlet=None, dirichlet_values=N
                              dtype=np.float64)
             if kap.shape != (X.shape[0] * s.size,):
                 raise ValueError(f"neumann_curvature must return shape (N,), got {kap.shape}")
+            _check_finite_values(kap, X.reshape(-1, 2), "neumann_curvature")
             kap = kap.reshape(X.shape[:2])
             mono = monomials(rp.reshape(-1, 2), p)["v"].reshape(rp.shape[0], s.size, -1)
             phi = np.einsum("nsm,ma->nsa", mono, space.coef)

@@ -37,6 +37,9 @@ __all__ = ["gauss_curvature", "gauss_curvature_intrinsic", "squared_edge_lengths
            "intrinsic_angles", "intrinsic_areas", "angle_defect", "intrinsic_mass_matrix"]
 
 TWO_PI = 2.0 * np.pi
+MAX_INDEX_SLACK = 16
+"""``gauss_curvature_intrinsic`` sizes K by ``F.max() + 1``; more than this many indices
+per face corner (beyond 65 536) is refused instead of allocating."""
 _BOUNDARY = ("natural", "geodesic", "defect")
 _MASS = ("consistent", "lumped")
 
@@ -61,6 +64,12 @@ def _topology(F, nV=None):
     else:
         n = 1 if nV is None else nV
     F = validate_faces(F, n)
+    if nV is None and n > MAX_INDEX_SLACK * 3 * F.shape[0] + (1 << 16):
+        n_used = np.unique(F).size
+        raise ValueError(f"F's largest vertex index is {n - 1} but F uses only {n_used} vertices: "
+                         f"K (one value per index 0..{n - 1}) would need {8 * n / 2**30:.3g} GB. "
+                         f"Compact the indices first: used, F = np.unique(F, return_inverse=True); "
+                         f"F = F.reshape(-1, 3) (then K[i] belongs to vertex used[i])")
     E, uE, EMAP, uEC, uEE = igl.unique_edge_map(F)
     count = np.diff(uEC)
     if (count > 2).any():

@@ -42,11 +42,22 @@ REF_EDGE_TANGENTS = REF_VERTICES[[2, 0, 1]] - REF_VERTICES[[1, 2, 0]]
 REF_EDGE_NORMALS = np.array([[1.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])
 
 
-def _check_int(value, name, minimum):
+MAX_DEGREE = 12
+"""Largest polynomial degree (Regge k, Lagrange p) accepted: the local systems grow like
+p⁴ and the Bernstein/monomial bases lose all accuracy in float64 well before p = 20."""
+
+MAX_QUAD_DEGREE = 64
+"""Largest quadrature degree accepted ((degree//2 + 1)² points per triangle)."""
+
+
+def _check_int(value, name, minimum, maximum=None, why=""):
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
         raise TypeError(f"{name} must be an integer, got {type(value).__name__}")
     if value < minimum:
-        raise ValueError(f"{name} must be >= {minimum}, got {value}")
+        raise ValueError(f"{name} must be >= {minimum}{why}, got {value}")
+    if maximum is not None and value > maximum:
+        raise ValueError(f"{name} must be <= {maximum} (the work grows like degree⁴ and float64 "
+                         f"cannot resolve higher degrees), got {value}")
     return int(value)
 
 
@@ -189,7 +200,7 @@ class LagrangeSpace:
 
     def __init__(self, tri, degree):
         self.tri = tri
-        p = self.degree = _check_int(degree, "Lagrange degree", 1)
+        p = self.degree = _check_int(degree, "Lagrange degree", 1, MAX_DEGREE)
         self.ref_nodes, self.coef = _lagrange_reference(p)
         self.n_local = self.ref_nodes.shape[0]
         m, F = tri.mesh, tri.F
@@ -274,7 +285,17 @@ def _call_scalar(func, X, name):
     vals = np.asarray(func(X), dtype=np.float64)
     if vals.shape != (X.shape[0],):
         raise ValueError(f"{name} must map (N, 2) points to shape (N,), got {vals.shape}")
+    _check_finite_values(vals, X, name)
     return vals
+
+
+def _check_finite_values(vals, X, name):
+    """A user callable's values must be finite (NaN would spread through the solve)."""
+    bad = ~np.isfinite(vals)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"{name} returned NaN or inf; first at point {np.asarray(X)[i].tolist()}: "
+                         f"{vals[i]}")
 
 
 def _check_points(tri, faces, bary):
@@ -493,10 +514,12 @@ def interpolate(P, F, metric, k, quad_degree=None):
     ReggeMetric
     """
     tri = PlanarTriangulation.coerce(P, F)
-    k = _check_int(k, "Regge degree k", 0)
+    k = _check_int(k, "Regge degree k", 0, MAX_DEGREE)
     if not callable(metric):
         raise TypeError(f"metric must be a callable (N, 2) -> (N, 2, 2), got {type(metric).__name__}")
-    qd = 2 * k + 16 if quad_degree is None else _check_int(quad_degree, "quad_degree", 0)
+    qd = 2 * k + 16 if quad_degree is None else _check_int(
+        quad_degree, "quad_degree", 2 * k, MAX_QUAD_DEGREE,
+        f" = 2k (the moment equations need exact products of degree-{k} polynomials)")
     ref = _regge_reference(k, qd)
     nF = tri.n_faces
     J = tri.J
