@@ -432,12 +432,37 @@ def _check_ply_properties(path, elements):
                 raise MeshFileError(f"{path}: corrupt PLY header: property {pname!r} of element "
                                     f"{name!r} has unknown type {' '.join(types)!r}")
     named = {name: props for name, _, props in elements}
+    _check_ply_property_groups(path, named)
     if "vertex" not in named or not {"x", "y", "z"} <= {p for p, t in named["vertex"] if t[0] != "list"}:
         raise MeshFileError(f"{path}: PLY header has no 'element vertex' with properties x, y, z")
     if "face" not in named or not any(p in ("vertex_indices", "vertex_index") and t[0] == "list"
                                       and t[2] in _PLY_INT_TYPES for p, t in named["face"]):
         raise MeshFileError(f"{path}: PLY header has no 'element face' with an integer list "
                             f"property vertex_indices")
+
+
+# Scalar properties that libigl 2.6's PLY reader requests together must share one type,
+# else tinyply's "all requested properties must share the same type" ends in a double
+# free (abort) or, for x/y/z, an empty V.  Measured groups: x/y/z, the colours, and all
+# the remaining scalar properties of the element; normals and texture coordinates of
+# mixed types read fine, so they are neither checked nor counted as remaining.
+_PLY_GROUPS = {"vertex": ({"x", "y", "z"}, {"red", "green", "blue", "alpha"}), "face": ()}
+_PLY_FREE = {"nx", "ny", "nz", "u", "v", "s", "t", "texture_u", "texture_v"}
+
+
+def _check_ply_property_groups(path, named):
+    """Properties libigl reads together must share one type (see ``_PLY_GROUPS``)."""
+    for element, groups in _PLY_GROUPS.items():
+        scalars = [(p, t[0]) for p, t in named.get(element, ()) if t[0] != "list"]
+        known = set().union(_PLY_FREE, *groups)
+        for group in groups + (None,):
+            members = [(p, t) for p, t in scalars if (p in group if group else p not in known)]
+            if len({t for _, t in members}) > 1:
+                listed = ", ".join(f"{p} {t}" for p, t in members)
+                raise MeshFileError(
+                    f"{path}: PLY properties of element {element!r} read together have "
+                    f"different types ({listed}); libigl's PLY reader cannot read that "
+                    f"(it aborts): store them with one type")
 
 
 def _check_ply(path, head, size):

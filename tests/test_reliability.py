@@ -205,6 +205,20 @@ FILES = {   # name: (content, exit code, message)
                       + b"\xff" + np.arange(3, dtype="<i4").tobytes(), 3, "declares 255 corners"),
     "huge_section.mesh": (b"MeshVersionFormatted 1\nDimension 3\nVertices\n2000000000\n0 0 0 0\n",
                           3, "declares 2000000000 records"),
+    # libigl aborts (double free) when properties it reads together differ in type
+    "mixed_types.ply": (b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                        b"property float z\nproperty double quality\nproperty float k\nelement face 1\n"
+                        b"property list uchar int vertex_indices\nend_header\n0 0 0 0 0\n1 0 0 0 0\n"
+                        b"0 1 0 0 0\n3 0 1 2\n", 3, "different types (quality double, k float)"),
+    "mixed_colours.ply": (b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                          b"property float z\nproperty uchar red\nproperty float green\nproperty uchar blue\n"
+                          b"element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                          b"0 0 0 1 1 1\n1 0 0 1 1 1\n0 1 0 1 1 1\n3 0 1 2\n", 3, "different types"),
+    # normals of mixed types read fine: accepted
+    "mixed_normals.ply": (b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                          b"property float z\nproperty float nx\nproperty double ny\nproperty float nz\n"
+                          b"element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                          b"0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n", 0, ""),
 }
 
 
