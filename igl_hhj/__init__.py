@@ -15,11 +15,13 @@ biharmonic solver, also as :func:`biharmonic_solve`), :mod:`igl_hhj.baselines`
 :mod:`igl_hhj.mesh_io` (guarded mesh reading, curvature output files),
 :mod:`igl_hhj.mesh_report` (what a mesh is made of and whether igl_hhj accepts it),
 :mod:`igl_hhj.surfaces` (exact test surfaces and mesh sequences), :mod:`igl_hhj.benchmarks`,
-:mod:`igl_hhj.cli` (the ``igl-hhj`` command).
+:mod:`igl_hhj.cli` (the ``igl-hhj`` command), :mod:`igl_hhj.recovery` (vertex recovery and
+smoothing scale of the drop-in), :mod:`igl_hhj.boundary_estimation` (data-free boundary normals).
 """
 import importlib
 
 from .curvature import (
+    boundary_treatment,
     face_gaussian_curvature,
     face_mean_curvature,
     face_principal_curvature,
@@ -34,13 +36,14 @@ from .mesh import TriangleMesh, validate_mesh
 __version__ = "0.1.0"
 
 _LAZY_MODULES = {"regge", "biharmonic", "baselines", "viewer", "surfaces", "benchmarks",
-                 "hhj", "mesh", "convergence", "cli", "mesh_io", "mesh_report"}
+                 "hhj", "mesh", "convergence", "cli", "mesh_io", "mesh_report", "recovery",
+                 "boundary_estimation"}
 _LAZY_ATTRS = {"biharmonic_solve": "biharmonic", "BiharmonicSolver": "biharmonic"}
 
 __all__ = [
     "shape_operator", "surface_hessian", "principal_curvature",
     "face_principal_curvature", "face_mean_curvature", "face_gaussian_curvature",
-    "principal_from_shape_operator", "TriangleMesh", "validate_mesh",
+    "principal_from_shape_operator", "boundary_treatment", "TriangleMesh", "validate_mesh",
     "biharmonic_solve", "BiharmonicSolver", "SolverError", "SolverDidNotConverge",
 ]
 
