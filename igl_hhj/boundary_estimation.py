@@ -9,7 +9,7 @@ accurate, and the error within two rings of the boundary stops converging.
 
 :func:`estimate_boundary_normals` fits, at each boundary vertex x_v, a height
 function ``z = g_1 x + g_2 y + ½(a x² + 2b xy + c y²)`` through x_v in the tangent
-frame of a first normal over the vertices of its ``rings``-ring (weighted
+frame of a first normal over the vertices of its ``rings``-ring (3 by default) (weighted
 least squares, one 5×5 system per boundary vertex, assembled with bincount),
 and returns ``(n - g_1 e_1 - g_2 e_2)/|·|``.  The fit is exact for quadrics, so
 the normal is O(h²) accurate on smooth surfaces; one re-fit in the new frame
@@ -83,15 +83,19 @@ def _fit_normals(X, verts, row, col, N0, scale):
     return Nn, ok
 
 
-def estimate_boundary_normals(mesh: TriangleMesh, rings=2):
+def estimate_boundary_normals(mesh: TriangleMesh, rings=3):
     """O(h²) unit normals at the boundary vertices from local quadric fits.
 
     Parameters
     ----------
     mesh : TriangleMesh (open: with boundary edges)
-    rings : int, default 2
-        Fit neighbourhood in rings (a boundary vertex has ~8–12 vertices in its
-        2-ring); vertices with fewer than 10 neighbours there (corners) use one ring more.
+    rings : int, default 3
+        Fit neighbourhood in rings; vertices with fewer than 10 neighbours there
+        (corners) use one ring more.  Measured on the open saddle (18k faces,
+        drop-in radius 5, rms H error within 2 rings of the boundary): clean
+        0.044 / 0.057 / 0.075 with 2 / 3 / 4 rings (libigl 0.103); with 0.02·h̄
+        normal noise 0.62 / 0.39 / 0.34 (libigl 0.31): wider fits pass less
+        noise into the clamped data and keep the O(h²) rate.
 
     Returns
     -------

@@ -13,13 +13,14 @@ few sparse products:
   validation (relative area 1e-12) carries a tensor of size ~1/its height, and
   ``|T| q_T ~ |T|²/h²`` removes it from its neighbours' values while a
   well-shaped face keeps its area weight (``q ≥ 0.5`` for angles ≥ 30°).
-* **smoothing** (:func:`smooth_vertex_tensors`): one implicit diffusion step
-  of the six components of the ambient tensor field, ``(M + t L) X = M S_v``
-  with libigl's cotangent stiffness ``L = -igl.cotmatrix`` and lumped
-  (Voronoi) mass ``M = igl.massmatrix``, ``t = ℓ²``, then the projection onto
-  the vertex tangent plane keeps every tensor symmetric and tangential.  Its
-  kernel has width ~ℓ; with ℓ proportional to the mesh size the bias is
-  O(ℓ²) = O(h²) and the O(h) rate of S_h is kept.
+* **smoothing** (:func:`smooth_vertex_tensors`): implicit diffusion steps
+  ``(M + t L) X = M X_prev`` of the six components of the ambient tensor
+  field with libigl's cotangent entries and a lumped mass (both weighted by
+  face reliability, :func:`smoothing_matrices`), combined by Tukey's twicing
+  ``2G - G²`` (bias O(ℓ⁴) instead of O(ℓ²)), then a trace-keeping projection
+  onto the vertex tangent plane keeps every tensor symmetric and tangential.
+  Its kernel has width ~ℓ; with ℓ proportional to the mesh size the bias is
+  O(h⁴) in smooth regions and the O(h) rate of S_h is kept.
 
 Costs (``python -m igl_hhj.benchmarks.robustness --timing``) are reported in
 the README section "Noisy scans and open meshes".

@@ -54,7 +54,7 @@ MESH_DIR = Path(__file__).resolve().parents[3] / "shared" / "data" / "meshes"
 
 # --------------------------------------------------------------------------- meshes
 def _surfaces(quick):
-    n_closed = 3 if quick else 4
+    n_closed = 3 if quick else 5
     n_open = 4 if quick else 5
     out = {}
     s = su.Ellipsoid()
@@ -62,7 +62,7 @@ def _surfaces(quick):
                         su.ellipsoid_coarse(s, subdivisions=2, amount=0.45, seed=7))
     if not quick:
         t = su.WalkerTorus()
-        out["torus"] = (t, su.mesh_sequence(*su.torus_coarse(n_phi=16, n_t=8, amount=0.2), t, n_closed),
+        out["torus"] = (t, su.mesh_sequence(*su.torus_coarse(n_phi=16, n_t=8, amount=0.2), t, n_closed - 1),
                         su.torus_coarse(n_phi=16, n_t=8, amount=0.45, seed=7))
     g = su.WalkerSaddle()
     out["saddle (open)"] = (g, su.mesh_sequence(*su.graph_coarse(g, n=6, amount=0.2), g, n_open),
@@ -169,18 +169,29 @@ def _have_pymeshlab():
         return False
 
 
-def run_method(name, V, F):
-    """→ (location, k1, k2, d1) with location "vertex" or "face"."""
+def run_method(name, V, F, cache=None):
+    """→ (location, k1, k2, d1) with location "vertex" or "face".
+
+    The HHJ variants share one solve through ``cache`` (a dict): the same
+    S_h and the same steps as ``igl_hhj.principal_curvature(V, F, radius)`` /
+    ``igl_hhj.face_principal_curvature(V, F)``."""
     import igl
 
-    import igl_hhj
     from .. import baselines
-    if name.startswith("hhj r"):
-        PD1, _, PV1, PV2, _ = igl_hhj.principal_curvature(V, F, int(name[5:]))
+    from ..curvature import (principal_from_shape_operator, shape_operator, vertex_principal_curvature,
+                             vertex_shape_operator)
+    if name.startswith("hhj"):
+        cache = {} if cache is None else cache
+        if "S" not in cache:
+            cache["mesh"] = TriangleMesh(V, F)
+            cache["S"] = shape_operator(V, F)
+        m, S = cache["mesh"], cache["S"]
+        if name == "hhj face":
+            PD1, _, PV1, PV2 = principal_from_shape_operator(S, m.face_normals)
+            return "face", PV1, PV2, PD1
+        Sv, N = vertex_shape_operator(m, S, smoothing=int(name[5:]))
+        PD1, _, PV1, PV2 = vertex_principal_curvature(m, Sv, N)
         return "vertex", PV1, PV2, PD1
-    if name == "hhj face":
-        PD1, _, PV1, PV2 = igl_hhj.face_principal_curvature(V, F)
-        return "face", PV1, PV2, PD1
     if name.startswith("libigl r"):
         PD1, _, PV1, PV2, _ = igl.principal_curvature(V, F, int(name[8:]))
         return "vertex", np.asarray(PV1), np.asarray(PV2), np.asarray(PD1)
@@ -258,9 +269,10 @@ def accuracy(quick, progress):
                 jobs.append((sname, surface, fname, lev, row))
     bar = progress(total=len(jobs) * len(methods), desc="robustness", unit="run", mininterval=2.0)
     for sname, surface, fname, lev, (V, F, X) in jobs:
+        cache = {}
         for meth in methods:
             bar.set_postfix_str(f"{sname} {fname} L{lev} {meth}")
-            loc, k1, k2, d1 = run_method(meth, V, F)
+            loc, k1, k2, d1 = run_method(meth, V, F, cache)
             res.setdefault(sname, {}).setdefault(fname, {}).setdefault(meth, []).append(
                 errors(surface, V, F, X, loc, k1, k2, d1))
             bar.update()
