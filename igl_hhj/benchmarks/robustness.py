@@ -15,8 +15,8 @@ sequence at every level:
   (s = 0.01, 0.02, 0.05, 0.1); exact values at the projected point;
 * ``flips``: an independent set of ~15 % of the interior edges flipped (only
   flips that keep the faces' orientation and add no duplicate edge);
-* ``slivers``: a strongly jittered coarse mesh (0.45) refined: its thin
-  triangles persist at every level.
+* ``slivers``: the coarse mesh jittered by 0.45 (fold-free) and refined: its
+  thin triangles persist at every level.
 
 Methods: the drop-in ``igl_hhj.principal_curvature`` at radius 1, 2, 5 (5 is
 the default), HHJ per face (Walker's S_h), ``igl.principal_curvature`` at
@@ -58,15 +58,12 @@ def _surfaces(quick):
     n_open = 4 if quick else 5
     out = {}
     s = su.Ellipsoid()
-    out["ellipsoid"] = (s, su.mesh_sequence(*su.ellipsoid_coarse(s, subdivisions=2, amount=0.2), s, n_closed),
-                        su.ellipsoid_coarse(s, subdivisions=2, amount=0.45, seed=7))
+    out["ellipsoid"] = (s, su.mesh_sequence(*su.ellipsoid_coarse(s, subdivisions=2, amount=0.2), s, n_closed))
     if not quick:
         t = su.WalkerTorus()
-        out["torus"] = (t, su.mesh_sequence(*su.torus_coarse(n_phi=16, n_t=8, amount=0.2), t, n_closed - 1),
-                        su.torus_coarse(n_phi=16, n_t=8, amount=0.45, seed=7))
+        out["torus"] = (t, su.mesh_sequence(*su.torus_coarse(n_phi=16, n_t=8, amount=0.2), t, n_closed - 1))
     g = su.WalkerSaddle()
-    out["saddle (open)"] = (g, su.mesh_sequence(*su.graph_coarse(g, n=6, amount=0.2), g, n_open),
-                            su.graph_coarse(g, n=6, amount=0.45, seed=7))
+    out["saddle (open)"] = (g, su.mesh_sequence(*su.graph_coarse(g, n=6, amount=0.2), g, n_open))
     return out
 
 
@@ -119,24 +116,30 @@ def flip_edges(V, F, fraction, seed):
     return G, len(sel) / max(int(interior.sum()), 1)
 
 
-def families(surface, seq, sliver_coarse, n_levels):
+def fold_free_jitter(V, F, surface, amount, seed):
+    """:func:`igl_hhj.surfaces.jitter_tangentially` (boundary vertices fixed) whose
+    vertices on faces that would fold or get 10× thinner than average stay put."""
+    fixed = TriangleMesh(V, F).boundary_vertices
+    W = su.jitter_tangentially(V, F, surface, amount, seed=seed, fixed=fixed)
+    for _ in range(20):
+        bad = _folded_faces(W, F, surface)
+        if not bad.any():
+            break
+        back = np.unique(F[bad])
+        W[back] = V[back]
+    if _folded_faces(W, F, surface).any():
+        raise RuntimeError(f"jitter {amount} folded a mesh")
+    return W
+
+
+def families(surface, seq, n_levels):
     """dict family → list of (V, F, exact-point X) per level."""
     fam = {}
-    is_open = isinstance(surface, su.GraphSurface)
     fam["clean"] = [(V, F, V) for V, F in seq]
     for a in JITTERS:
         rows = []
         for k, (V, F) in enumerate(seq):
-            fixed = TriangleMesh(V, F).boundary_vertices if is_open else None
-            W = su.jitter_tangentially(V, F, surface, a, seed=100 + k, fixed=fixed)
-            for _ in range(20):          # fold-free: vertices of folded faces go back
-                bad = _folded_faces(W, F, surface)
-                if not bad.any():
-                    break
-                back = np.unique(F[bad])
-                W[back] = V[back]
-            if _folded_faces(W, F, surface).any():
-                raise RuntimeError(f"jitter {a} folded a mesh")
+            W = fold_free_jitter(V, F, surface, a, 100 + k)
             rows.append((W, F, W))
         fam[f"jitter {a:.2f}"] = rows
     for s in NOISES:
@@ -152,10 +155,8 @@ def families(surface, seq, sliver_coarse, n_levels):
         G, _ = flip_edges(V, F, FLIP_FRACTION, seed=300 + k)
         rows.append((V, G, V))
     fam["flips"] = rows
-    V0, F0 = sliver_coarse
-    if is_open:
-        V0 = surface.project(V0)
-    sl = su.mesh_sequence(V0, F0, surface, n_levels)
+    V0, F0 = seq[0]
+    sl = su.mesh_sequence(fold_free_jitter(V0, F0, surface, 0.45, 7), F0, surface, n_levels)
     fam["slivers"] = [(V, F, V) for V, F in sl]
     return fam
 
@@ -262,8 +263,8 @@ def accuracy(quick, progress):
     res = {}
     surf = _surfaces(quick)
     jobs = []
-    for sname, (surface, seq, sliver) in surf.items():
-        fam = families(surface, seq, sliver, len(seq))
+    for sname, (surface, seq) in surf.items():
+        fam = families(surface, seq, len(seq))
         for fname, rows in fam.items():
             for lev, row in enumerate(rows):
                 jobs.append((sname, surface, fname, lev, row))
@@ -272,9 +273,13 @@ def accuracy(quick, progress):
         cache = {}
         for meth in methods:
             bar.set_postfix_str(f"{sname} {fname} L{lev} {meth}")
-            loc, k1, k2, d1 = run_method(meth, V, F, cache)
-            res.setdefault(sname, {}).setdefault(fname, {}).setdefault(meth, []).append(
-                errors(surface, V, F, X, loc, k1, k2, d1))
+            try:
+                loc, k1, k2, d1 = run_method(meth, V, F, cache)
+                e = errors(surface, V, F, X, loc, k1, k2, d1)
+            except (ValueError, RuntimeError) as exc:      # reported, not fatal
+                e = {"error": str(exc).splitlines()[0], "h": float("nan"), "faces": len(F)}
+                print(f"{sname} {fname} L{lev} {meth}: {e['error']}")
+            res.setdefault(sname, {}).setdefault(fname, {}).setdefault(meth, []).append(e)
             bar.update()
     bar.close()
     return res, methods
