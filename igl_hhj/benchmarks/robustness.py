@@ -540,15 +540,15 @@ def bunny_picture(out):
     raw = out / "robustness_bunny_raw.png"
     R = np.array([[1.0, 0, 0], [0, 1, 0], [0, 0, 1]])
     reg = viewer.register_comparison(V @ R.T, F, hhj=hhj, libigl=lib, per="vertex", enabled="H",
-                                     robust=2, screenshot=str(raw), size=(1600, 800))
+                                     robust=5, screenshot=str(raw), size=(1600, 800))
     lo, hi = reg.ranges["H"]
     img = mpimg.imread(str(raw))
-    fig = plt.figure(figsize=(10, 5.6))
-    ax = fig.add_axes([0, 0.14, 1, 0.86])
+    fig = plt.figure(figsize=(10, 5.8))
+    ax = fig.add_axes([0, 0.14, 1, 0.78])
     ax.imshow(img)
     ax.axis("off")
-    ax.set_title("bunny, mean curvature H: igl_hhj.principal_curvature (left), igl.principal_curvature (right)",
-                 fontsize=10)
+    fig.text(0.5, 0.95, "bunny, mean curvature H (5th–95th percentile range): igl_hhj.principal_curvature "
+             "(left), igl.principal_curvature (right)", ha="center", fontsize=9)
     cax = fig.add_axes([0.25, 0.07, 0.5, 0.035])
     sm = plt.cm.ScalarMappable(cmap="coolwarm", norm=matplotlib.colors.Normalize(lo, hi))
     fig.colorbar(sm, cax=cax, orientation="horizontal")
