@@ -5,14 +5,15 @@ tensor per face.  The drop-in :func:`igl_hhj.principal_curvature` needs one per
 vertex, and on noisy meshes it needs a length scale.  Both are done here with a
 few sparse products:
 
-* **recovery** (:func:`recover_vertex_tensors`): the weighted L2 projection of
-  the face field onto P1, lumped (``S_v = Σ_T w_T S_T / Σ_T w_T``) or with the
-  consistent P1 mass matrix, each vertex value projected onto its tangent
-  plane ``P_v S_v P_v``.  The face weight ``w_T = |T| q_T`` is the area times
-  the shape quality ``q_T = 4√3 |T| / Σ l_i²`` ∈ (0, 1]: a sliver accepted by
-  validation (relative area 1e-12) carries a tensor of size ~1/its height, and
-  ``|T| q_T ~ |T|²/h²`` removes it from its neighbours' values while a
-  well-shaped face keeps its area weight (``q ≥ 0.5`` for angles ≥ 30°).
+* **recovery** (:func:`recover_vertex_tensors`): a weighted least-squares
+  linear fit of the face values over the incident faces ("patch", default),
+  the lumped weighted L2 projection onto P1 (``S_v = Σ_T w_T S_T / Σ_T w_T``)
+  or the consistent-mass one, each vertex value projected onto its tangent
+  plane.  The face weights (:func:`recovery_weights`) are the areas, reduced
+  on slivers and their edge neighbours: a sliver accepted by validation
+  (relative area 1e-12) carries a tensor of size ~1/its height that must not
+  reach its vertices (``tests/test_recovery.py`` checks |κ - 1| < 0.15 next to
+  a 1e-11 face on the unit sphere).
 * **smoothing** (:func:`smooth_vertex_tensors`): implicit diffusion steps
   ``(M + t L) X = M X_prev`` of the six components of the ambient tensor
   field with libigl's cotangent entries and a lumped mass (both weighted by
@@ -67,8 +68,8 @@ def recovery_weights(mesh: TriangleMesh):
     ``q~_T`` is the smallest shape quality (:func:`face_quality`) of T and its
     edge neighbours: the HHJ tensors of a sliver *and of the faces sharing an
     edge with it* are unreliable (the sliver's three conormals are nearly
-    parallel, so its nn-moments cannot be matched; measured |H - 1| up to 1.3
-    on those neighbours on the unit sphere).  Faces with ``q~ ≥ 0.1`` (no angle
+    parallel, so its nn-moments cannot be matched and the error reaches the
+    neighbours' tensors too).  Faces with ``q~ ≥ 0.1`` (no angle
     below ~6° nearby) keep their area weight; a sliver of relative area 1e-12
     and its neighbours get ~1e-11 of it."""
     q = face_quality(mesh)
@@ -314,8 +315,8 @@ def smooth_vertex_tensors(mesh: TriangleMesh, Sv, N, length, *, steps=SMOOTHING_
     matrix for every step and component: one sparse matrix, CG with 6
     right-hand sides).  The result is ``(I - (I - G)^order) S_v``; order 2 is
     Tukey's twicing ``2 G S_v - G² S_v``: the O(ℓ²Δ_Γ S) bias of G cancels,
-    leaving O(ℓ⁴), which allows a 2–3× longer ℓ at the same bias (measured on
-    clean, jittered and noisy meshes).  Finally ``P_v X_v P_v`` keeps every tensor symmetric and tangential.
+    leaving O(ℓ⁴), which allows a longer ℓ at the same bias (error vs radius:
+    ``python -m igl_hhj.benchmarks.robustness``).  Finally ``P_v X_v P_v`` keeps every tensor symmetric and tangential.
 
     Parameters
     ----------

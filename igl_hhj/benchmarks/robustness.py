@@ -313,6 +313,39 @@ def radius_sweep(quick):
     return out
 
 
+def recovery_comparison(quick):
+    """rms H error of the vertex recoveries of S_h without smoothing (lumped area
+    average, consistent-mass L2 projection, linear patch fit) and of the default
+    drop-in, on the ellipsoid: clean, jittered 0.30, noise 0.02."""
+    import igl
+
+    from .. import recovery as rc
+    from ..curvature import shape_operator, vertex_principal_curvature, vertex_shape_operator
+    s = su.Ellipsoid()
+    seq = su.mesh_sequence(*su.ellipsoid_coarse(s, subdivisions=2, amount=0.2), s, 3 if quick else 4)
+    V0, F = seq[-1]
+    h = TriangleMesh(V0, F).mean_edge_length
+    cases = {"clean": V0, "jitter 0.30": fold_free_jitter(V0, F, s, 0.30, 11),
+             "noise 0.02": V0 + 0.02 * h * np.random.default_rng(6).normal(size=(len(V0), 1)) * s.normal(V0)}
+    out = {"faces": len(F), "rows": {}}
+    for name, V in cases.items():
+        m = TriangleMesh(V, F)
+        Hx = s.mean_curvature(s.project(V))
+        S = shape_operator(V, F)
+        row = {}
+        for meth in ("lumped", "consistent", "patch"):
+            Sv, N = rc.recover_vertex_tensors(m, S, method=meth)
+            _, _, a, b = vertex_principal_curvature(m, Sv, N)
+            row[meth] = float(np.sqrt(np.mean((0.5 * (a + b) - Hx) ** 2)))
+        Sv, N = vertex_shape_operator(m, S, smoothing=5)
+        _, _, a, b = vertex_principal_curvature(m, Sv, N)
+        row["drop-in r5"] = float(np.sqrt(np.mean((0.5 * (a + b) - Hx) ** 2)))
+        q = igl.principal_curvature(V, F, 2)
+        row["libigl r2"] = float(np.sqrt(np.mean((0.5 * (q[2] + q[3]) - Hx) ** 2)))
+        out["rows"][name] = row
+    return out
+
+
 def real_meshes(quick):
     """Agreement (correlation of H, relative median difference) and roughness
     (rms of H minus its 1-ring mean, relative to rms H) on the shared meshes."""
@@ -404,7 +437,7 @@ def _eoc(runs, region, key="H"):
     return float(np.log(e[-2] / e[-1]) / np.log(h[-2] / h[-1]))
 
 
-def report(res, methods, sweep, real, tim, out):
+def report(res, methods, sweep, real, tim, out, rec=None):
     lines = ["# Robustness benchmark (`python -m igl_hhj.benchmarks.robustness`)", ""]
     lines += ["Finest level of each sequence: rms error of H (max error, EOC of the rms error over the "
               "last refinement), per region. 'interior' = farther than 2 rings from the boundary, "
@@ -457,6 +490,13 @@ def report(res, methods, sweep, real, tim, out):
                   "|---|" + "---|" * len(sweep["radii"])]
         for k, v in sweep["curves"].items():
             lines.append(f"| {k} | " + " | ".join(_fmt(x) for x in v) + " |")
+        lines.append("")
+    if rec:
+        cols = list(next(iter(rec["rows"].values())))
+        lines += [f"## Vertex recovery of S_h (ellipsoid, {rec['faces']} faces, rms H error, no smoothing "
+                  "unless stated)", "", "| mesh | " + " | ".join(cols) + " |", "|---|" + "---|" * len(cols)]
+        for k, r in rec["rows"].items():
+            lines.append(f"| {k} | " + " | ".join(_fmt(r[c]) for c in cols) + " |")
         lines.append("")
     if real:
         lines += ["## Real meshes (no exact answer): drop-in (radius 5) vs igl.principal_curvature (radius 5)", ""]
@@ -574,11 +614,12 @@ def main(argv=None):
     t0 = time.perf_counter()
     res, methods = accuracy(args.quick, tqdm)
     sweep = radius_sweep(args.quick)
+    rec = recovery_comparison(args.quick)
     real = [] if args.no_real else real_meshes(args.quick)
     tim = timing(5 if args.quick else 7) if args.timing else None
-    text = report(res, methods, sweep, real, tim, out)
-    (out / "robustness.json").write_text(json.dumps({"accuracy": res, "radius_sweep": sweep, "real": real,
-                                                      "timing": tim}, indent=1))
+    text = report(res, methods, sweep, real, tim, out, rec)
+    (out / "robustness.json").write_text(json.dumps({"accuracy": res, "radius_sweep": sweep, "recovery": rec,
+                                                      "real": real, "timing": tim}, indent=1))
     plots(res, methods, sweep, out)
     pic = None
     if not args.no_picture:
