@@ -562,7 +562,6 @@ def plots(res, methods, sweep, out):
 
 def bunny_picture(out):
     """Bunny H: drop-in (left) vs igl.principal_curvature (right), one colour range, colour bar."""
-    import igl
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.image as mpimg
@@ -578,8 +577,7 @@ def bunny_picture(out):
     hhj = baselines.hhj_vertex(V, F)
     lib = baselines.libigl_quadric(V, F)
     raw = out / "robustness_bunny_raw.png"
-    R = np.array([[1.0, 0, 0], [0, 1, 0], [0, 0, 1]])
-    reg = viewer.register_comparison(V @ R.T, F, hhj=hhj, libigl=lib, per="vertex", enabled="H",
+    reg = viewer.register_comparison(V, F, hhj=hhj, libigl=lib, per="vertex", enabled="H",
                                      robust=5, screenshot=str(raw), size=(1600, 800))
     lo, hi = reg.ranges["H"]
     img = mpimg.imread(str(raw))
@@ -596,8 +594,35 @@ def bunny_picture(out):
     fig.savefig(p, dpi=80)
     plt.close(fig)
     raw.unlink()
-    del igl
     return p
+
+
+def run(out, *, quick=False, timing_run=False, real=True, picture=True):
+    """Run the benchmark, write the report, JSON and plots into ``out``; returns the results dict."""
+    from tqdm import tqdm
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    res, methods = accuracy(quick, tqdm)
+    sweep = radius_sweep(quick)
+    rec = recovery_comparison(quick)
+    real_rows = real_meshes(quick) if real else []
+    tim = timing(5 if quick else 7) if timing_run else None
+    text = report(res, methods, sweep, real_rows, tim, out, rec)
+    results = {"accuracy": res, "radius_sweep": sweep, "recovery": rec, "real": real_rows, "timing": tim}
+    (out / "robustness.json").write_text(json.dumps(results, indent=1))
+    plots(res, methods, sweep, out)
+    pic = None
+    if picture:
+        try:
+            pic = bunny_picture(out)
+        except Exception as exc:     # no EGL: the tables are still useful
+            print(f"no bunny picture: {str(exc).splitlines()[0]}")
+    print(text)
+    print(f"wrote {out}/robustness.md, robustness.json, plots{', ' + str(pic) if pic else ''} "
+          f"in {time.perf_counter() - t0:.0f} s")
+    results["text"] = text
+    return results
 
 
 def main(argv=None):
@@ -608,28 +633,7 @@ def main(argv=None):
     ap.add_argument("--no-real", action="store_true", help="skip the shared/data meshes")
     ap.add_argument("--no-picture", action="store_true", help="skip the bunny screenshot (needs EGL)")
     args = ap.parse_args(argv)
-    from tqdm import tqdm
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    t0 = time.perf_counter()
-    res, methods = accuracy(args.quick, tqdm)
-    sweep = radius_sweep(args.quick)
-    rec = recovery_comparison(args.quick)
-    real = [] if args.no_real else real_meshes(args.quick)
-    tim = timing(5 if args.quick else 7) if args.timing else None
-    text = report(res, methods, sweep, real, tim, out, rec)
-    (out / "robustness.json").write_text(json.dumps({"accuracy": res, "radius_sweep": sweep, "recovery": rec,
-                                                      "real": real, "timing": tim}, indent=1))
-    plots(res, methods, sweep, out)
-    pic = None
-    if not args.no_picture:
-        try:
-            pic = bunny_picture(out)
-        except Exception as exc:     # no EGL: the tables are still useful
-            print(f"no bunny picture: {str(exc).splitlines()[0]}")
-    print(text)
-    print(f"wrote {out}/robustness.md, robustness.json, plots{', ' + str(pic) if pic else ''} "
-          f"in {time.perf_counter() - t0:.0f} s")
+    run(args.out, quick=args.quick, timing_run=args.timing, real=not args.no_real, picture=not args.no_picture)
     return 0
 
 
