@@ -35,13 +35,18 @@ from .mesh import TriangleMesh
 
 __all__ = [
     "face_quality", "recovery_weights", "recovery_operator", "vertex_confidence", "QUALITY_FLOOR", "recover_vertex_tensors", "smooth_vertex_tensors",
-    "smoothing_length", "smoothing_matrices", "SMOOTHING_PER_RADIUS", "SMOOTHING_STEPS", "SMOOTHING_ORDER", "tangent_projection",
+    "smoothing_length", "smoothing_matrices", "boundary_band", "BOUNDARY_LENGTH_FACTOR", "SMOOTHING_PER_RADIUS", "SMOOTHING_STEPS", "SMOOTHING_ORDER", "tangent_projection",
 ]
 
 # Smoothing length ℓ = SMOOTHING_PER_RADIUS · radius · h̄ (h̄ = mean edge length).
 # Measured by ``python -m igl_hhj.benchmarks.robustness --sweep`` (error vs radius on
 # clean, jittered and noisy meshes).
 SMOOTHING_PER_RADIUS = 0.2
+# Near an open boundary (faces touching the 2-ring band) the smoothing length is this
+# many times longer: the diffusion sees half a neighbourhood there (natural boundary
+# condition), so with the same ℓ the boundary band keeps twice the noise.
+BOUNDARY_LENGTH_FACTOR = 2.0
+BOUNDARY_BAND_RINGS = 2
 # implicit steps per application of the diffusion (see smooth_vertex_tensors)
 SMOOTHING_STEPS = 2
 # bias-reduction order of the kernel: 1 plain diffusion G, 2 twicing 2G - G², 3: 3G - 3G² + G³
@@ -262,11 +267,28 @@ def smoothing_length(mesh: TriangleMesh, radius):
     return SMOOTHING_PER_RADIUS * float(radius) * mesh.mean_edge_length
 
 
+def boundary_band(mesh: TriangleMesh, rings=BOUNDARY_BAND_RINGS):
+    """(#V,) bool: vertices within ``rings`` rings of the boundary (none on closed meshes)."""
+    b = mesh.boundary_vertices.copy()
+    if not b.any():
+        return b
+    F = mesh.F
+    nV = mesh.n_vertices
+    i = np.concatenate([F[:, 0], F[:, 1], F[:, 2]])
+    j = np.concatenate([F[:, 1], F[:, 2], F[:, 0]])
+    A = sp.coo_matrix((np.ones(len(i)), (i, j)), shape=(nV, nV)).tocsr()
+    A = A + A.T
+    for _ in range(rings):
+        b = b | (A @ b.astype(np.float64) > 0)
+    return b
+
+
 def smoothing_matrices(mesh: TriangleMesh, weights=None):
     """Weighted lumped mass and cotangent stiffness of the smoothing, ``(M_w, L_w)``.
 
-    ``M_w = diag(Σ_{T∋v} r_T w_T / 3)`` and ``L_w = Σ_T r_T L_T``, ``r_T = w_T/|T|`` ∈ [0, 1]
-    the reliability of T (1 on well-shaped faces), ``L_T`` the
+    ``M_w = diag(Σ_{T∋v} r_T w_T / 3)`` and ``L_w = Σ_T b_T² r_T L_T``, ``r_T = w_T/|T|`` ∈ [0, 1]
+    the reliability of T (1 on well-shaped faces), ``b_T`` = ``BOUNDARY_LENGTH_FACTOR``
+    (2) on faces touching the 2-ring boundary band and 1 elsewhere, ``L_T`` the
     face's cotangent stiffness (``igl.cotmatrix_entries``; with ``w_T = |T|``
     this is ``-igl.cotmatrix``), ``w`` the :func:`recovery_weights`.  Scaling
     each face's stiffness by its reliability keeps it positive semidefinite and
@@ -283,7 +305,11 @@ def smoothing_matrices(mesh: TriangleMesh, weights=None):
     F = mesh.F
     with np.errstate(invalid="ignore", divide="ignore"):
         fac = np.where(mesh.face_areas > 0, w / mesh.face_areas, 0.0)
-    C = np.asarray(igl.cotmatrix_entries(mesh.V, F), dtype=np.float64) * fac[:, None]
+    stiff = fac
+    if mesh.has_boundary:       # longer smoothing length ℓ near the boundary: t ∝ ℓ²
+        near = boundary_band(mesh)[F].any(axis=1)
+        stiff = fac * np.where(near, BOUNDARY_LENGTH_FACTOR ** 2, 1.0)
+    C = np.asarray(igl.cotmatrix_entries(mesh.V, F), dtype=np.float64) * stiff[:, None]
     C = np.where(np.isfinite(C), C, 0.0)
     j = F[:, [1, 2, 0]]
     k = F[:, [2, 0, 1]]
