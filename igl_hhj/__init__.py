@@ -17,7 +17,8 @@ biharmonic solver, also as :func:`biharmonic_solve`), :mod:`igl_hhj.baselines`
 :mod:`igl_hhj.interop` (trimesh / pyvista / meshio mesh objects in, results back onto them),
 :mod:`igl_hhj.demos` (the demos, ``igl-hhj demo NAME``),
 :mod:`igl_hhj.surfaces` (exact test surfaces and mesh sequences), :mod:`igl_hhj.benchmarks`,
-:mod:`igl_hhj.cli` (the ``igl-hhj`` command).
+:mod:`igl_hhj.cli` (the ``igl-hhj`` command), :mod:`igl_hhj.recovery` (vertex recovery and
+smoothing scale of the drop-in), :mod:`igl_hhj.boundary_estimation` (data-free boundary normals).
 """
 import importlib
 
@@ -25,13 +26,14 @@ __version__ = "0.1.0"
 
 _LAZY_MODULES = {"regge", "biharmonic", "baselines", "viewer", "surfaces", "benchmarks",
                  "hhj", "mesh", "convergence", "cli", "mesh_io", "mesh_report",
-                 "curvature", "errors", "interop", "demos"}
+                 "curvature", "errors", "interop", "demos",
+                 "recovery", "boundary_estimation"}
 # The core names resolve on first use too, so that ``import igl_hhj`` (and the
 # ``igl-hhj`` command's start-up, where Ctrl-C must not print a traceback) costs
 # no numpy/scipy import.
 _LAZY_ATTRS = {"biharmonic_solve": "biharmonic", "BiharmonicSolver": "biharmonic",
                **{name: "curvature" for name in (
-                   "face_gaussian_curvature", "face_mean_curvature", "face_principal_curvature",
+                   "boundary_treatment", "face_gaussian_curvature", "face_mean_curvature", "face_principal_curvature",
                    "principal_curvature", "principal_from_shape_operator", "shape_operator",
                    "surface_hessian")},
                "SolverError": "errors", "SolverDidNotConverge": "errors",
@@ -40,7 +42,7 @@ _LAZY_ATTRS = {"biharmonic_solve": "biharmonic", "BiharmonicSolver": "biharmonic
 __all__ = [
     "shape_operator", "surface_hessian", "principal_curvature",
     "face_principal_curvature", "face_mean_curvature", "face_gaussian_curvature",
-    "principal_from_shape_operator", "TriangleMesh", "validate_mesh",
+    "principal_from_shape_operator", "boundary_treatment", "TriangleMesh", "validate_mesh",
     "biharmonic_solve", "BiharmonicSolver", "SolverError", "SolverDidNotConverge",
 ]
 

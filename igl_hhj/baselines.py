@@ -126,13 +126,14 @@ def _given_shape_operator(mesh, S, kwargs):
     return S
 
 
-def hhj_vertex(V, F=None, *, shape_operator=None, **kwargs):
+def hhj_vertex(V, F=None, *, shape_operator=None, radius=5, **kwargs):
     """HHJ drop-in at the vertices (:func:`igl_hhj.curvature.principal_curvature`).
 
     Parameters
     ----------
     shape_operator : (#F, 3, 3), optional, a precomputed S_h (skips the solve).
-    **kwargs : boundary data / solver, see :func:`igl_hhj.shape_operator`.
+    radius : int, default 5, the drop-in's smoothing scale.
+    **kwargs : boundary treatment / data / solver, see :func:`igl_hhj.shape_operator`.
 
     Returns
     -------
@@ -140,35 +141,38 @@ def hhj_vertex(V, F=None, *, shape_operator=None, **kwargs):
     """
     from .curvature import principal_curvature, vertex_principal_curvature, vertex_shape_operator
     if shape_operator is None:
-        PD1, PD2, PV1, PV2, bad = principal_curvature(V, F, **kwargs)
+        PD1, PD2, PV1, PV2, bad = principal_curvature(V, F, radius, **kwargs)
     else:
         mesh = as_mesh(V, F)
-        Sv, N = vertex_shape_operator(mesh, _given_shape_operator(mesh, shape_operator, kwargs))
+        Sv, N = vertex_shape_operator(mesh, _given_shape_operator(mesh, shape_operator, kwargs),
+                                      smoothing=radius)
         PD1, PD2, PV1, PV2 = vertex_principal_curvature(mesh, Sv, N)
         PD1, PD2, PV1, PV2, bad = mark_bad_vertices(mesh, PD1, PD2, PV1, PV2)
     return _ordered("hhj_vertex", "vertex", PV1, PV2, 0.5 * (PV1 + PV2), PV1 * PV2, PD1, PD2, bad)
 
 
-def hhj_face(V, F=None, *, shape_operator=None, **kwargs):
+def hhj_face(V, F=None, *, shape_operator=None, smoothing=0, **kwargs):
     """Walker's HHJ shape operator S_h per face (eq. 5.12/5.14).
 
     Parameters
     ----------
     shape_operator : (#F, 3, 3), optional, a precomputed S_h (skips the solve).
-    **kwargs : boundary data / solver, see :func:`igl_hhj.shape_operator`.
+    smoothing : float, default 0 (S_h itself), see :func:`igl_hhj.face_principal_curvature`.
+    **kwargs : boundary treatment / data / solver, see :func:`igl_hhj.shape_operator`.
 
     Returns
     -------
     CurvatureEstimate, location "face": eigenvalues/vectors of S_h in the face
     plane, ``H = tr(S_h)/2``, ``K = det(S_h + ν_T ⊗ ν_T)`` (Walker eq. 6.1).
     """
-    from .curvature import principal_from_shape_operator
+    from .curvature import principal_from_shape_operator, smoothed_face_shape_operator
     from .curvature import shape_operator as solve_shape_operator
     mesh = as_mesh(V, F)
     if shape_operator is None:
         S = solve_shape_operator(mesh.V, mesh.F, **kwargs)
     else:
         S = _given_shape_operator(mesh, shape_operator, kwargs)
+    S = smoothed_face_shape_operator(mesh, S, smoothing)
     nu = mesh.face_normals
     d1, d2, k1, k2 = principal_from_shape_operator(S, nu)
     H = 0.5 * np.trace(S, axis1=1, axis2=2)

@@ -263,13 +263,27 @@ def _curvature(args):
     stages = _Stages(n_stages, large)
     stages.done(f"reading and validating {mesh.n_faces} faces", t_read)
 
+    if args.radius is not None and (isinstance(args.radius, bool) or args.radius < 0
+                                    or (args.radius == 0 and not (args.method == "hhj" and per == "face"))):
+        raise UserError(f"--radius must be a positive integer (0 only with --per face), got {args.radius}")
+    if args.method == "heine" and args.radius is not None:
+        raise UserError("--radius applies to --method hhj and igl, not heine")
+    radius = args.radius if args.radius is not None else (0 if per == "face" else 5)
+    scale = {"smoothing": radius} if per == "face" else {"radius": radius}
+
     t = time.perf_counter()
     S = None
     if keep_S:        # solve once, keep S_h for the npz, derive the curvatures from it
         from .curvature import shape_operator
         S = stages.run(f"{METHOD_LABELS[args.method]} (shape operator)", shape_operator, mesh.V, mesh.F)
         hhj = baselines.hhj_face if per == "face" else baselines.hhj_vertex
-        est = stages.run(f"curvatures ({per})", hhj, mesh.V, mesh.F, shape_operator=S)
+        est = stages.run(f"curvatures ({per})", hhj, mesh.V, mesh.F, shape_operator=S, **scale)
+    elif args.method == "hhj":
+        hhj = baselines.hhj_face if per == "face" else baselines.hhj_vertex
+        est = stages.run(f"{METHOD_LABELS[args.method]} ({per})", hhj, mesh.V, mesh.F, **scale)
+    elif args.method == "igl":
+        est = stages.run(f"{METHOD_LABELS[args.method]} ({per})", baselines.libigl_quadric,
+                         mesh.V, mesh.F, radius=radius)
     else:
         est = stages.run(f"{METHOD_LABELS[args.method]} ({per})",
                          baselines.estimate, ESTIMATORS[args.method, per], mesh.V, mesh.F)
@@ -278,6 +292,12 @@ def _curvature(args):
     say(f"{args.mesh}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, "
           f"{int(mesh.boundary_edges.sum())} boundary edges")
     say(f"  method {args.method} per {per}: {dt:.2f} s")
+    if args.method == "hhj":
+        say(f"  smoothing scale (--radius): {radius}" + (" (none: Walker's S_h per face)" if radius == 0 else ""))
+        if mesh.has_boundary:
+            say("  boundary: clamped with estimated normals (quadric fits; igl_hhj.boundary_estimation)")
+    elif args.method == "igl":
+        say(f"  radius: {radius} rings")
     for name, x in [("k1", est.k1), ("k2", est.k2), ("H", est.H), ("K", est.K)]:
         q = np.nanpercentile(x, [1, 50, 99]) if np.isfinite(x).any() else [np.nan] * 3
         say(f"  {name:>3}: 1% {q[0]: .4g}   median {q[1]: .4g}   99% {q[2]: .4g}")
@@ -430,6 +450,10 @@ def build_parser():
     c.add_argument("--per", choices=["face", "vertex"], default="vertex",
                    help="vertex (default, comparable with libigl) or face (HHJ's native "
                         "piecewise-constant values; hhj only)")
+    c.add_argument("--radius", type=int, default=None, metavar="R",
+                   help="scale: for hhj the smoothing length in rings / mean edge lengths "
+                        "(default 5 per vertex as igl.principal_curvature, 0 per face: Walker's S_h); "
+                        "for igl the k-ring size (default 5)")
     c.add_argument("-o", "--out", metavar="OUT",
                    help="output file, by extension: OUT.npz (k1, k2, H, K, d1, d2, V, F, and the "
                         "shape operator S for hhj), OUT.csv (one row per vertex or face), OUT.ply "

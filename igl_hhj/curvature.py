@@ -14,18 +14,24 @@ from numpy.typing import ArrayLike, NDArray
 
 from .hhj import HHJProjection, clamped_load, face_tensors
 from .mesh import TriangleMesh, as_mesh, mark_bad_vertices, per_vertex_array
+from . import recovery as _recovery
+from .boundary_estimation import BOUNDARY_TREATMENTS, estimate_boundary_normals
 
 __all__ = [
     "shape_operator", "surface_hessian", "principal_curvature",
     "face_principal_curvature", "face_mean_curvature", "face_gaussian_curvature",
     "principal_from_shape_operator", "vertex_shape_operator", "vertex_principal_curvature",
-    "check_principal_curvature_args",
+    "check_principal_curvature_args", "boundary_treatment", "smoothed_face_shape_operator",
 ]
 
 
 # --------------------------------------------------------------------------- helpers
-def _boundary_partition(mesh, boundary_normals, boundary_shape_operator, simply_supported):
-    """Return (clamped_with_data (#E,) bool, simply_supported_edges (#E,) bool)."""
+def _boundary_partition(mesh, boundary_normals, boundary_shape_operator, simply_supported,
+                        estimated=False):
+    """Return (clamped_with_data (#E,) bool, simply_supported_edges (#E,) bool).
+
+    ``estimated``: the normals come from :func:`estimate_boundary_normals`, whose NaN
+    rows mark vertices without a usable normal; their edges keep the plain assembly."""
     bnd = mesh.boundary_edges
     ss_edges = np.zeros(mesh.n_edges, dtype=bool)
     if simply_supported is not None:
@@ -43,7 +49,48 @@ def _boundary_partition(mesh, boundary_normals, boundary_shape_operator, simply_
                              "simply_supported (#V bool) to say which boundary edges are simply supported")
         ss_edges = bnd.copy()
     clamped = bnd & ~ss_edges if boundary_normals is not None else np.zeros_like(bnd)
+    if estimated:
+        usable = np.isfinite(boundary_normals).all(axis=1)
+        clamped &= usable[mesh.edges[:, 0]] & usable[mesh.edges[:, 1]]
     return clamped, ss_edges
+
+
+def _check_boundary(boundary):
+    if not isinstance(boundary, str) or boundary not in BOUNDARY_TREATMENTS:
+        raise ValueError(f"boundary must be one of {BOUNDARY_TREATMENTS}, got {boundary!r}")
+
+
+def _resolve_boundary(mesh, boundary, boundary_normals, boundary_shape_operator):
+    """Boundary data to use: the caller's, or (``boundary="estimate"``, an open mesh and
+    no data) the O(h²) normals of :func:`igl_hhj.boundary_estimation.estimate_boundary_normals`
+    as clamped data.  Returns ``(boundary_normals, treatment)``, treatment one of
+    "none" (closed), "data", "estimate", "plain"."""
+    _check_boundary(boundary)
+    if not mesh.has_boundary:
+        return boundary_normals, "none"
+    if boundary_normals is not None or boundary_shape_operator is not None:
+        return boundary_normals, "data"
+    if boundary == "plain":
+        return None, "plain"
+    return estimate_boundary_normals(mesh), "estimate"
+
+
+def boundary_treatment(V, F, *, boundary="estimate", boundary_normals=None,
+                       boundary_shape_operator=None):
+    """Which boundary treatment :func:`shape_operator` applies to this mesh and these arguments.
+
+    Returns
+    -------
+    str : "none" (closed mesh), "data" (the caller's boundary data), "estimate"
+        (clamped with estimated O(h²) normals) or "plain" (plain assembly).
+    """
+    mesh = as_mesh(V, F)
+    _check_boundary(boundary)
+    if not mesh.has_boundary:
+        return "none"
+    if boundary_normals is not None or boundary_shape_operator is not None:
+        return "data"
+    return boundary
 
 
 def _data_rows(mesh, A, edge_mask, name):
@@ -110,9 +157,10 @@ def _simply_supported_values(mesh, boundary_shape_operator, ss_edges):
     return rho
 
 
-def _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver):
+def _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver,
+                    estimated=False):
     clamped, ss_edges = _boundary_partition(mesh, boundary_normals, boundary_shape_operator,
-                                            simply_supported)
+                                            simply_supported, estimated)
     proj = HHJProjection(mesh, fixed_edges=ss_edges, solver=solver)
     X = mesh.V
     load = proj.plain_boundary_load(X)
@@ -132,7 +180,8 @@ def _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supp
 
 
 # --------------------------------------------------------------------------- public API
-def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary_normals: ArrayLike | None = None,
+def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary: str = "estimate",
+                   boundary_normals: ArrayLike | None = None,
                    boundary_shape_operator: ArrayLike | None = None, simply_supported: ArrayLike | None = None,
                    solver: str = "auto") -> NDArray[np.float64]:
     """Walker's HHJ approximation S_h of the shape operator ∇_Γν, one tensor per face.
@@ -148,6 +197,14 @@ def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary_normals: Arra
         Vertex positions.
     F : (#F, 3) array_like of int
         Consistently oriented triangles (never reordered).
+    boundary : {"estimate", "plain"}, default "estimate"
+        What to do on an open mesh *without* boundary data: "estimate" makes
+        the boundary edges clamped with O(h²) normals fitted to the mesh
+        (:func:`igl_hhj.boundary_estimation.estimate_boundary_normals`), which
+        keeps the O(h) rate up to the boundary; "plain" is Walker's plain
+        assembly (the face normal stands in for the true one: about O(h^1/2)
+        in L2 near the boundary, no convergence in L∞).  Ignored when
+        boundary data is given or the mesh is closed.
     boundary_normals : (#V, 3) array_like, optional
         True unit surface normals at (at least) the boundary vertices; boundary
         edges not simply supported become *clamped* edges with this data
@@ -175,11 +232,13 @@ def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary_normals: Arra
 
     Notes
     -----
-    Without boundary data, boundary edges get the *plain assembly* (the face
-    normal stands in for the true one); the method still runs on any mesh but
-    its rate near the boundary drops to about O(h^1/2).  Triangles with all
+    Without boundary data and with ``boundary="plain"``, boundary edges get
+    the *plain assembly* (the face normal stands in for the true one); the
+    method still runs on any mesh but its rate near the boundary drops to
+    about O(h^1/2).  Triangles with all
     three vertices on the boundary (excluded by Walker's Property 1) are
     allowed: A stays SPD; their values are least accurate.
+
     Examples
     --------
     >>> import numpy as np, igl_hhj
@@ -192,7 +251,10 @@ def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary_normals: Arra
     2.0
     """
     mesh = as_mesh(V, F)
-    S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver)
+    boundary_normals, treatment = _resolve_boundary(mesh, boundary, boundary_normals,
+                                                    boundary_shape_operator)
+    S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver,
+                        estimated=treatment == "estimate")
     bad = ~np.isfinite(S).all(axis=(1, 2))
     if bad.any():                     # never silent NaN (issue 12)
         from .errors import SolverError
@@ -288,10 +350,21 @@ def principal_from_shape_operator(S: NDArray[np.floating], normals: NDArray[np.f
     return PD1, PD2, PV1, PV2
 
 
-def face_principal_curvature(V: Any, F: ArrayLike | None = None, **boundary: Any) -> tuple[NDArray[np.float64], ...]:
+def face_principal_curvature(V: Any, F: ArrayLike | None = None, *, smoothing: float = 0,
+                             **boundary: Any) -> tuple[NDArray[np.float64], ...]:
     """Per-face principal curvatures and directions from the HHJ shape operator.
 
-    Keyword arguments are those of :func:`shape_operator`.
+    Parameters
+    ----------
+    V, F : mesh (see :func:`shape_operator`).
+    smoothing : float, default 0
+        Smoothing scale in the units of :func:`principal_curvature`'s ``radius``
+        (rings ≈ mean edge lengths).  0: Walker's S_h itself.  > 0: S_h is
+        recovered at the vertices, smoothed at length
+        ``ℓ = SMOOTHING_PER_RADIUS · smoothing · h̄``
+        (:func:`igl_hhj.recovery.smooth_vertex_tensors`), and each face gets
+        the mean of its three vertex tensors projected onto its plane.
+    **boundary : ``boundary``, boundary data, ``solver`` of :func:`shape_operator`.
 
     Returns
     -------
@@ -308,7 +381,28 @@ def face_principal_curvature(V: Any, F: ArrayLike | None = None, **boundary: Any
     """
     mesh = as_mesh(V, F)
     S = shape_operator(mesh, None, **boundary)   # the validated mesh passes through as_mesh
+    S = smoothed_face_shape_operator(mesh, S, smoothing)
     return principal_from_shape_operator(S, mesh.face_normals)
+
+
+def smoothed_face_shape_operator(mesh, S, smoothing):
+    """Face tensors at smoothing scale ``smoothing`` (see :func:`face_principal_curvature`).
+
+    Returns S itself for ``smoothing == 0``; otherwise (#F, 3, 3) symmetric
+    tensors tangential to each face."""
+    _check_smoothing(smoothing, "smoothing")
+    if smoothing == 0:
+        return S
+    Sv, N = vertex_shape_operator(mesh, S, smoothing=smoothing)
+    Sf = np.nanmean(Sv[mesh.F], axis=1)
+    return _recovery.tangent_projection(Sf, mesh.face_normals)
+
+
+def _check_smoothing(x, name):
+    if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, float, np.integer, np.floating)):
+        raise TypeError(f"{name} must be a number, got {type(x).__name__}")
+    if not (np.isfinite(x) and x >= 0):
+        raise ValueError(f"{name} must be finite and >= 0, got {x}")
 
 
 def face_mean_curvature(V: Any, F: ArrayLike | None = None, **boundary: Any) -> NDArray[np.float64]:
@@ -356,32 +450,37 @@ def vertex_principal_curvature(mesh, Sv, N):
     return PD1, PD2, PV1, PV2
 
 
-def vertex_shape_operator(mesh, S):
-    """Recover per-vertex tensors from face tensors.
+def vertex_shape_operator(mesh, S, *, smoothing=0, recovery="patch"):
+    """Recover per-vertex tensors from face tensors, optionally smoothed.
 
-    Area-weighted average over the incident faces of the face tensors
-    projected onto the vertex tangent plane, ``S_v = Σ_T |T| P_v S_T P_v / Σ_T |T|``
-    with ``P_v = I - N_v ⊗ N_v`` and N_v the area-weighted vertex normal
-    (``igl.per_vertex_normals``).  This is a lumped-mass L2 projection onto P1;
-    it converges at the same O(h) rate as S_h (tests measure it).
+    1. Recovery (:func:`igl_hhj.recovery.recover_vertex_tensors`): by default
+       a weighted least-squares *linear* fit of the incident face tensors in the
+       vertex tangent frame evaluated at the vertex ("patch", exact for linear
+       fields, so irregular 1-rings do not bias it); "lumped" is the weighted
+       average ``Σ_T w_T S_T / Σ_T w_T``; "consistent" the consistent-mass L2
+       projection onto P1.  Face weights ``w_T = |T| q_T`` (area × shape
+       quality) keep slivers from poisoning their neighbours.  Each value is
+       projected onto the vertex tangent plane, ``P_v S_v P_v`` with
+       ``P_v = I - N_v ⊗ N_v``, N_v the area-weighted vertex normal
+       (``igl.per_vertex_normals``).
+    2. Smoothing (``smoothing > 0``, units of ``radius`` in
+       :func:`principal_curvature`): :func:`igl_hhj.recovery.smooth_vertex_tensors`
+       at length ``ℓ = SMOOTHING_PER_RADIUS · smoothing · h̄``.
 
     Returns
     -------
-    Sv : (#V, 3, 3) float64 (NaN rows for unreferenced vertices)
+    Sv : (#V, 3, 3) float64 symmetric tangential tensors (NaN rows for unreferenced vertices)
     N : (#V, 3) vertex normals used
     """
-    N = mesh.vertex_normals
-    A = np.broadcast_to(mesh.face_areas[:, None], (mesh.n_faces, 3))
-    acc = mesh.sum_corners_to_vertices(A[:, :, None, None] * S[:, None])
-    wsum = mesh.sum_corners_to_vertices(A)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        Sv = acc / wsum[:, None, None]
-    P = np.eye(3)[None] - N[:, :, None] * N[:, None, :]
-    Sv = P @ Sv @ P
+    _check_smoothing(smoothing, "smoothing")
+    Sv, N = _recovery.recover_vertex_tensors(mesh, S, method=recovery)
+    if smoothing > 0:
+        Sv = _recovery.smooth_vertex_tensors(mesh, Sv, N, _recovery.smoothing_length(mesh, smoothing))
     return Sv, N
 
 
 def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, useKring: bool = True, *,
+                        boundary: str = "estimate",
                         boundary_normals: ArrayLike | None = None, boundary_shape_operator: ArrayLike | None = None,
                         simply_supported: ArrayLike | None = None, solver: str = "auto"
                         ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
@@ -390,9 +489,9 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
 
     Same call forms, same return tuple, shapes, dtypes, ordering and sign, but
     the values come from Walker's convergent HHJ shape operator
-    (:func:`shape_operator`) recovered at the vertices by
-    :func:`vertex_shape_operator` (area-weighted average of the face tensors
-    projected onto the vertex tangent plane), then a 2×2 eigen-problem.
+    (:func:`shape_operator`), recovered at the vertices and smoothed at the
+    length scale ``radius`` (:func:`vertex_shape_operator`), then a 2×2
+    eigen-problem.
 
     Parameters
     ----------
@@ -401,10 +500,19 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
     F : (#F, 3) array_like
         Triangle indices.
     radius : int, default 5
-        Accepted for compatibility and **ignored**: the HHJ method has no
-        neighbourhood size.  The recovery always uses the incident faces.
+        Smoothing scale, as libigl's neighbourhood size: rings (``useKring``)
+        or mean edge lengths (``useKring=False``), which for HHJ are the same
+        length ``ℓ = SMOOTHING_PER_RADIUS · radius · h̄`` (h̄ the mean edge
+        length, ``SMOOTHING_PER_RADIUS`` = 0.2) of the implicit diffusion of
+        the recovered tensor field (:func:`igl_hhj.recovery.smooth_vertex_tensors`).
+        Larger: less noise, more bias.  ℓ shrinks with h, so the values
+        converge at O(h) for every fixed radius.
     useKring : bool, default True
-        Accepted for compatibility and **ignored** (see ``radius``).
+        Accepted for compatibility (see ``radius``).
+    boundary : {"estimate", "plain"}, default "estimate"
+        Open meshes without boundary data: clamped with estimated O(h²) normals
+        (converges up to the boundary) or the plain assembly (see
+        :func:`shape_operator`).
     boundary_normals, boundary_shape_operator, simply_supported, solver
         Keyword-only extras, see :func:`shape_operator`.
 
@@ -433,8 +541,11 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
     """
     check_principal_curvature_args(radius, useKring)
     mesh = as_mesh(V, F)
-    S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver)
-    Sv, N = vertex_shape_operator(mesh, S)
+    boundary_normals, treatment = _resolve_boundary(mesh, boundary, boundary_normals,
+                                                    boundary_shape_operator)
+    S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver,
+                        estimated=treatment == "estimate")
+    Sv, N = vertex_shape_operator(mesh, S, smoothing=radius)
     PD1, PD2, PV1, PV2 = vertex_principal_curvature(mesh, Sv, N)
     PD1, PD2, PV1, PV2, bad = mark_bad_vertices(mesh, PD1, PD2, PV1, PV2)
     return (np.ascontiguousarray(PD1), np.ascontiguousarray(PD2),

@@ -134,10 +134,11 @@ class _Lines:
     n_corner : how many tokens are OBJ face corners (``i``, ``i/j``, ``i//k``, ``-i``)
     zero_corner : one of those corners contains the index 0
     int_k : how many of tokens 2 .. 1 + first are non-negative integers (OFF face lines)
+    maxlen : length of the longest token
     """
 
     FIELDS = ("offset", "lineno", "ntok", "c0", "flen", "first", "n_num", "n_corner",
-              "zero_corner", "int_k")
+              "zero_corner", "int_k", "maxlen")
 
     def __init__(self, path, start, comments=True, first_line=1, corners=False):
         parts = {k: [] for k in self.FIELDS}
@@ -238,7 +239,9 @@ class _Lines:
                 "flen": flen.astype(np.int64), "first": first,
                 "n_num": per_line(number), "n_corner": per_line(corner),
                 "zero_corner": per_line(corner & zero) > 0,
-                "int_k": per_line((pos > 0) & (pos <= kk) & digits)}
+                "int_k": per_line((pos > 0) & (pos <= kk) & digits),
+                "maxlen": (np.maximum.reduceat(e - s, head) if head.size
+                           else np.zeros(0, dtype=np.int64)).astype(np.int64)}
 
     def text(self, path, i, limit=60):
         """The i-th non-empty line (at most ``limit`` characters), for messages."""
@@ -514,6 +517,11 @@ def _check_ply(path, head, size):
             k = L.first[rows]
             _check_rows(path, L, rows, k != 3, "face is not a triangle (only triangle meshes are "
                         "supported: libigl's PLY reader aborts on mixed polygons)")
+            # an index of 10 or more digits is beyond any vertex count a PLY header can
+            # declare here, and from 2³¹ on libigl's reader overflows and aborts
+            _check_rows(path, L, rows, L.maxlen[rows] >= 10,
+                        f"face line has a vertex index of 10 or more digits (the header declares "
+                        f"{counts.get('vertex', 0)} vertices)")
             if lists == [p for p, _ in props if p in ("vertex_indices", "vertex_index")]:
                 want = 1 + 3 + (len(props) - len(lists))
                 _check_rows(path, L, rows, L.ntok[rows] != want,

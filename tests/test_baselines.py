@@ -230,7 +230,10 @@ def test_compare_estimators_quick_run(tmp_path):
     # the same measurement as the convergence test, through the benchmark's error code:
     heine_H = [r["H"] for r in res["accuracy"]["Heine (5.1a), jittered 30%"]["runs"]["heine"]]
     hhj_H = [r["H"] for r in res["accuracy"]["Heine (5.1a), jittered 30%"]["runs"]["hhj_vertex"]]
-    assert hhj_H[-1] < 0.5 * heine_H[-1]
+    # (the drop-in's default smoothing, radius 5, adds a bias on these coarse meshes;
+    # the rates tell the converging method from the stalling one)
+    assert hhj_H[-1] < heine_H[-1]
+    assert hhj_H[-2] / hhj_H[-1] > 1.6 and heine_H[-2] / heine_H[-1] < 1.2
     assert res["speed"][0]["runs"]["libigl_quadric"]["time"] > 0
     with pytest.raises(ValueError, match="unknown estimators"):
         run(tmp_path, quick=True, estimators=["nope"])

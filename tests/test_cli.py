@@ -191,6 +191,25 @@ def test_curvature_methods_are_the_baselines(sphere, tmp_path, method, fn):
     assert np.median(d["H"]) > 0                       # outward sphere: positive
 
 
+def test_curvature_radius(sphere, tmp_path, capsys):
+    """--radius is the drop-in's smoothing scale (and libigl's k-ring for --method igl)."""
+    path, V, F = sphere
+    out = tmp_path / "k.npz"
+    assert cli.main(["curvature", str(path), "--radius", "2", "-o", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "smoothing scale (--radius): 2" in text and "boundary:" not in text   # closed mesh
+    np.testing.assert_allclose(np.load(out)["k1"], baselines.hhj_vertex(V, F, radius=2).k1, rtol=1e-10)
+    assert not np.allclose(np.load(out)["k1"], baselines.hhj_vertex(V, F).k1)
+    assert cli.main(["curvature", str(path), "--per", "face", "--radius", "3", "-o", str(out), "-q"]) == 0
+    np.testing.assert_allclose(np.load(out)["k1"], baselines.hhj_face(V, F, smoothing=3).k1, rtol=1e-10)
+    assert cli.main(["curvature", str(path), "--method", "igl", "--radius", "3", "-o", str(out), "-q"]) == 0
+    np.testing.assert_allclose(np.load(out)["k1"], baselines.libigl_quadric(V, F, radius=3).k1, rtol=1e-10)
+    capsys.readouterr()
+    for bad in (["--radius", "0"], ["--radius", "-1"], ["--method", "heine", "--radius", "2"]):
+        assert cli.main(["curvature", str(path), *bad]) == 2
+        assert "--radius" in one_error_line(capsys.readouterr().err)
+
+
 def test_curvature_sign_follows_orientation(tmp_path):
     V, F = unit_sphere(2)
     path = write_off(tmp_path / "inward.off", V, F[:, ::-1])
@@ -260,7 +279,9 @@ def test_curvature_real_mesh_with_boundary(tmp_path, capsys):
     path = real_mesh("camelhead.off")
     out = tmp_path / "camel.csv"
     assert cli.main(["curvature", str(path), "-o", str(out)]) == 0
-    assert "56 boundary edges" in capsys.readouterr().out
+    text = capsys.readouterr().out
+    assert "56 boundary edges" in text
+    assert text.count("boundary: clamped with estimated normals") == 1
     V, F = igl.read_triangle_mesh(str(path))
     csv = np.loadtxt(out, delimiter=",", skiprows=1)
     assert csv.shape == (len(V), 11) and np.isfinite(csv).all()

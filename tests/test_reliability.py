@@ -214,6 +214,9 @@ FILES = {   # name: (content, exit code, message)
                           b"property float z\nproperty uchar red\nproperty float green\nproperty uchar blue\n"
                           b"element face 1\nproperty list uchar int vertex_indices\nend_header\n"
                           b"0 0 0 1 1 1\n1 0 0 1 1 1\n0 1 0 1 1 1\n3 0 1 2\n", 3, "different types"),
+    # an index from 2³¹ on overflows libigl's ascii PLY reader (abort); found by the fuzzer
+    "huge_index.ply": (_ply(b"0 0 0\n1 0 0\n0 1 0\n3 0 1 2147483648\n"), 3,
+                       "vertex index of 10 or more digits"),
     # normals of mixed types read fine: accepted
     "mixed_normals.ply": (b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
                           b"property float z\nproperty float nx\nproperty double ny\nproperty float nz\n"
@@ -362,7 +365,8 @@ def test_demo_negative_seed_is_one_line(capsys):
 def test_solver_and_other_failures_are_one_line(sphere_off, monkeypatch, capsys, exc, code, match):
     def boom(*a, **k):
         raise exc
-    monkeypatch.setattr(baselines, "estimate", boom)
+    for name in ("estimate", "hhj_vertex"):     # what `curvature` calls for the default method
+        monkeypatch.setattr(baselines, name, boom)
     assert cli.main(["curvature", str(sphere_off)]) == code
     assert match in one_error_line(capsys.readouterr().err)
     with pytest.raises(type(exc)):                       # --debug: the traceback
@@ -372,7 +376,8 @@ def test_solver_and_other_failures_are_one_line(sphere_off, monkeypatch, capsys,
 def test_interrupt_during_command_is_one_line(sphere_off, monkeypatch, capsys):
     def interrupted(*a, **k):
         raise KeyboardInterrupt
-    monkeypatch.setattr(baselines, "estimate", interrupted)
+    for name in ("estimate", "hhj_vertex"):
+        monkeypatch.setattr(baselines, name, interrupted)
     assert cli.main(["curvature", str(sphere_off)]) == cli.EXIT_INTERRUPTED
     assert capsys.readouterr().err.strip() == "igl-hhj: interrupted"
 

@@ -240,7 +240,7 @@ def test_boundary_data_only_on_boundary():
     S = exact_boundary_shape_operator(V, F, surface)
     assert np.isnan(N[~b]).all() and np.isfinite(N[b]).all()
     assert np.isnan(S[~b]).all() and np.allclose(S[b], surface.shape_operator(V[b]))
-    assert walker_boundary_data(V, F, surface, "plain") == {}
+    assert walker_boundary_data(V, F, surface, "plain") == {"boundary": "plain"}
     with pytest.raises(TypeError, match="ImplicitSurface"):
         exact_boundary_normals(V, F, "dumbbell")
     with pytest.raises(TypeError, match="ImplicitSurface"):

@@ -65,7 +65,8 @@ def walker_boundary_data(V, F, surface, kind):
     kind : {"clamped", "simply_supported", "plain"}
         "clamped": ``boundary_normals = I_h ν`` (eq. 5.19, Σ_c);
         "simply_supported": ``boundary_shape_operator = I_h ∇_Γν`` (eq. 5.18, Σ_s);
-        "plain": no data (plain assembly).
+        "plain": no data, plain assembly (``boundary="plain"``; without the
+        keyword, shape_operator would estimate the boundary normals).
 
     Returns
     -------
@@ -77,5 +78,5 @@ def walker_boundary_data(V, F, surface, kind):
         return {"boundary_shape_operator": exact_boundary_shape_operator(V, F, surface)}
     if kind == "plain":
         _check_surface(surface)
-        return {}
+        return {"boundary": "plain"}
     raise ValueError(f"unknown boundary kind {kind!r}; use 'clamped', 'simply_supported' or 'plain'")
