@@ -537,12 +537,22 @@ def _up_to_date(job):
 
 
 def _skipped_row(job, previous):
+    """Status ``skipped``, statistics from the previous summary or else from the ``.npz``."""
     old = previous.get(job.path)
     row = _row(job, "skipped")
-    if old is not None and old.get("status") in ("ok", "skipped"):
+    if old is not None and old.get("status") in ("ok", "skipped") and old.get("faces"):
         for c in SUMMARY_COLUMNS[3:]:
             if c not in ("seconds", "peak_memory", "error") and old.get(c) not in (None, ""):
                 row[c] = old[c]
+    elif job.output.endswith(".npz"):    # finished by a worker after the interrupt reached us
+        try:
+            from .baselines import CurvatureEstimate
+            with np.load(job.output) as z:
+                est = CurvatureEstimate(str(z["per"]), z["k1"], z["k2"], z["H"], z["K"],
+                                        None, None, np.zeros(0, np.int64))
+                row.update(vertices=len(z["V"]), faces=len(z["F"]), **_percentile_stats(est))
+        except (OSError, KeyError, ValueError):
+            pass
     return row
 
 

@@ -302,7 +302,9 @@ def _batch(args):
                                  workers=args.workers, method=args.method, per=args.per,
                                  radius=args.radius, fmt=args.format, resume=args.resume,
                                  timeout=args.timeout, memory_limit=args.memory_limit,
-                                 progress=not args.quiet)
+                                 progress=not args.quiet,
+                                 group_bytes=(batch.GROUP_BYTES if args.group_bytes is None
+                                              else args.group_bytes))
     except (ValueError, ImportError) as exc:
         raise UserError(str(exc)) from None
     except OSError as exc:
@@ -332,6 +334,11 @@ def _info(args):
 def batch_formats():
     from .batch import FORMATS
     return FORMATS
+
+
+def batch_group_bytes():
+    from .batch import GROUP_BYTES
+    return GROUP_BYTES
 
 
 def build_parser():
@@ -403,6 +410,9 @@ def build_parser():
                    help="seconds per mesh (status timeout when exceeded)")
     b.add_argument("--memory-limit", type=_memory_bytes, metavar="BYTES",
                    help="resident memory per mesh, e.g. 4G (status error when exceeded)")
+    b.add_argument("--group-bytes", type=int, default=None, metavar="N",
+                   help="group small input files into one task up to N bytes in total "
+                        "(default %d; 0: one mesh per task)" % batch_group_bytes())
     b.add_argument("-q", "--quiet", action="store_true", help="no progress bar / lines")
     b.set_defaults(func=_batch)
 
