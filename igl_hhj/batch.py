@@ -703,8 +703,10 @@ def _on_dask(client, groups, options, on_row, retry_singles=True):
                     for job in group:              # isolate the mesh that kills its worker
                         ac.add(submit([job], attempt + 1))
                     continue
-                what = ("the worker computing it died repeatedly (segfault or out of memory?)"
-                        if type(exc).__name__ == "KilledWorker" else f"{type(exc).__name__}: {exc}")
+                what = ("the worker process computing it died every time it was tried (a crash "
+                        "or out of memory; Dask's distributed.scheduler.allowed-failures retries)"
+                        if type(exc).__name__ == "KilledWorker" else
+                        f"{type(exc).__name__}: {' '.join(str(exc).split())}")
                 rows = [_row(job, "error", error=f"{job.path}: {what}") for job in group]
             for row in rows:
                 on_row(row)
@@ -716,12 +718,15 @@ def _on_dask(client, groups, options, on_row, retry_singles=True):
 def _local_cluster(n_workers, retries):
     import dask
     from distributed import LocalCluster
+    # worker-saturation 1.0: a worker holds only the task it runs, so a worker that dies takes
+    # no queued bystander task's retry budget with it
     with dask.config.set({"distributed.scheduler.allowed-failures": retries,
+                          "distributed.scheduler.worker-saturation": 1.0,
                           "distributed.worker.daemon": False,
                           "distributed.admin.tick.limit": "60s"}):
         return LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
                             dashboard_address=None, host="127.0.0.1", memory_limit=0,
-                            silence_logs=40)
+                            silence_logs=50)
 
 
 def _machine_cores():

@@ -208,6 +208,46 @@ def test_timeout_and_memory_limit(tmp_path):
     assert rows["small.obj"]["status"] == "ok"
 
 
+def test_worker_that_keeps_dying_is_an_error_row(tmp_path):
+    """A mesh whose worker process dies every time (here: SIGKILL while it computes it) is
+    retried a bounded number of times, separated from the meshes grouped with it, then an error row."""
+    import threading
+
+    import psutil
+    V, F = igl.icosahedron()
+    for _ in range(6):                                   # 81920 faces: ~200 MB more resident
+        V, F = igl.upsample(V, F)
+    igl.write_triangle_mesh(str(tmp_path / "a_big.off"), V / np.linalg.norm(V, axis=1, keepdims=True), F)
+    for i in range(4):
+        igl.write_triangle_mesh(str(tmp_path / f"small{i}.obj"), *igl.icosahedron())
+    kills, stop = [], threading.Event()
+
+    def killer():                     # the "crash": kill any worker process above 230 MB
+        while not stop.is_set():
+            for p in psutil.Process().children(recursive=True):
+                try:
+                    if "spawn_main" in " ".join(p.cmdline()) and p.memory_info().rss > 230e6:
+                        p.kill()
+                        kills.append(p.pid)
+                except psutil.Error:
+                    pass
+            time.sleep(0.02)
+
+    t = threading.Thread(target=killer, daemon=True)
+    t.start()
+    try:
+        res = batch.run_batch([tmp_path], tmp_path / "out", workers=1, retries=0,
+                              group_bytes=10**9, progress=False)
+    finally:
+        stop.set()
+        t.join()
+    rows = {Path(r["path"]).name: r for r in res.rows}
+    assert len(rows) == 5 and len(kills) == 2      # the group of 5, then a_big.off alone
+    assert rows["a_big.off"]["status"] == "error"
+    assert "worker process computing it died every time" in rows["a_big.off"]["error"]
+    assert all(rows[f"small{i}.obj"]["status"] == "ok" for i in range(4))
+
+
 # --------------------------------------------------------------------------- resume / SIGINT
 def _batch_cmd(*args):
     return [sys.executable, "-m", "igl_hhj.cli", "batch", *map(str, args)]
