@@ -660,6 +660,7 @@ class BatchResult:
     seconds: float = 0.0
     mode: str = ""
     interrupted: bool = False
+    total: int = 0
 
     def counts(self):
         c = {s: 0 for s in ("ok", "error", "skipped", "timeout")}
@@ -716,8 +717,26 @@ def _on_dask(client, groups, options, on_row, retry_singles=True):
 
 
 def _local_cluster(n_workers, retries):
+    """Embedded cluster of ``n_workers`` single-threaded worker processes on 127.0.0.1.
+
+    The workers are started with SIGINT ignored (inherited through exec): Ctrl-C in a
+    terminal signals the whole process group, and only this process should handle it
+    (cancel, clean up, write the summary) instead of every worker printing a traceback.
+    """
+    import signal
+
     import dask
     from distributed import LocalCluster
+    main = threading.current_thread() is threading.main_thread()
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+    try:
+        return _start_local_cluster(LocalCluster, dask, n_workers, retries)
+    finally:
+        if main:
+            signal.signal(signal.SIGINT, old)
+
+
+def _start_local_cluster(LocalCluster, dask, n_workers, retries):
     # worker-saturation 1.0: a worker holds only the task it runs, so a worker that dies takes
     # no queued bystander task's retry budget with it
     with dask.config.set({"distributed.scheduler.allowed-failures": retries,
@@ -864,4 +883,4 @@ def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per
         sweep_temporaries(outdir)
         done = [rows[j.path] for j in jobs if j.path in rows]
         files = write_summary(done, outdir)
-    return BatchResult(done, outdir, files, time.perf_counter() - t0, mode, interrupted)
+    return BatchResult(done, outdir, files, time.perf_counter() - t0, mode, interrupted, len(jobs))

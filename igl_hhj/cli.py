@@ -310,7 +310,8 @@ def _batch(args):
     except OSError as exc:
         raise UserError(f"{args.out}: {exc.strerror or exc}") from None
     c = result.counts()
-    print(f"{len(result.rows)} meshes: {c['ok']} ok, {c['error']} error, {c['timeout']} timeout, "
+    of = f" of {result.total}" if len(result.rows) < result.total else ""
+    print(f"{len(result.rows)}{of} meshes: {c['ok']} ok, {c['error']} error, {c['timeout']} timeout, "
           f"{c['skipped']} skipped in {result.seconds:.1f} s ({result.mode}); "
           f"summary {result.summary_files[0]}")
     if result.interrupted:

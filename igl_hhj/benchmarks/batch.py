@@ -5,7 +5,7 @@
 Collection (generated on the fly in a temporary folder, not kept): ``--meshes``
 meshes of mixed sizes, each under a random rigid motion: 40 % small ellipsoids
 (icosphere subdivisions, 320–5120 faces), 45 % the real meshes of ``--mesh-dir``
-(default ``../shared/data/meshes`` next to the repository; ellipsoids of 20k
+(default ``../shared/data/meshes`` next to the repository; ellipsoids of 5120
 faces if absent) as they are, 15 % those subdivided once (``igl.upsample``, ×4
 faces) when that gives at most :data:`MAX_FACES` faces (else as they are),
 written as ascii ``.off``.  The cap keeps the collection in the range where
@@ -74,7 +74,7 @@ def make_collection(folder, n=200, seed=0, mesh_dir=None):
         V, F = igl.upsample(*sphere[k - 1])
         sphere[k] = (V / np.linalg.norm(V, axis=1, keepdims=True), F)
     if not real:
-        real = [(f"ellipsoid{i}", sphere[5][0] * (1, 0.5 + 0.2 * i, 0.7), sphere[5][1]) for i in range(3)]
+        real = [(f"ellipsoid{i}", sphere[4][0] * (1, 0.5 + 0.2 * i, 0.7), sphere[4][1]) for i in range(3)]
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     out = []
