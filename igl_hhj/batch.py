@@ -81,7 +81,7 @@ IN_PROCESS_MAX_FILES = 4
 
 GROUP_BYTES = 400_000
 """Consecutive input files are grouped into one Dask task until their sizes add up to
-this many bytes (about 10k faces of ascii OFF); larger files are one task each.
+this many bytes (about 8k faces of ascii OFF); larger files are one task each.
 Chosen from ``python -m igl_hhj.benchmarks.batch`` (see README, "Many meshes")."""
 
 GROUP_MAX = 16
@@ -484,7 +484,9 @@ def plan_jobs(inputs, outdir, fmt="npz"):
     that differ only in extension keep it: ``a/b.off.npz``)."""
     if fmt not in FORMATS:
         raise ValueError(f"unknown format {fmt!r} (use {', '.join(FORMATS)})")
-    found = collect_inputs(inputs)
+    out_abs = os.path.abspath(outdir) + os.sep
+    found = [(q, r) for q, r in collect_inputs(inputs)       # outputs are never inputs
+             if not os.path.abspath(q).startswith(out_abs)]
     if not found:
         return []
     roots = [os.path.abspath(r) for _, r in found]
@@ -675,13 +677,6 @@ def _in_process(groups, options, on_row):
             on_row(row)
 
 
-def _cluster_lost(exc):
-    """Exceptions meaning "the worker died", not "the mesh failed"."""
-    name = type(exc).__name__
-    return name in ("KilledWorker", "CommClosedError", "FutureCancelledError",
-                    "CancelledError", "StreamClosedError", "EnvironmentError") or isinstance(exc, OSError)
-
-
 def _on_dask(client, groups, options, on_row, retry_singles=True):
     from distributed import as_completed
     futures = {}
@@ -740,9 +735,7 @@ def _start_local_cluster(LocalCluster, dask, n_workers, retries):
     # worker-saturation 1.0: a worker holds only the task it runs, so a worker that dies takes
     # no queued bystander task's retry budget with it
     with dask.config.set({"distributed.scheduler.allowed-failures": retries,
-                          "distributed.scheduler.worker-saturation": 1.0,
-                          "distributed.worker.daemon": False,
-                          "distributed.admin.tick.limit": "60s"}):
+                          "distributed.scheduler.worker-saturation": 1.0}):
         return LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
                             dashboard_address=None, host="127.0.0.1", memory_limit=0,
                             silence_logs=50)
@@ -857,7 +850,12 @@ def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per
             from distributed import Client
             if client is None:
                 if scheduler is not None:
-                    own_client = client = Client(scheduler, timeout="20s")
+                    try:
+                        # waits distributed.comm.timeouts.connect (default 30 s)
+                        own_client = client = Client(scheduler)
+                    except (OSError, TimeoutError, ValueError) as exc:
+                        raise ValueError(f"cannot connect to the Dask scheduler at {scheduler}: "
+                                         f"{' '.join(str(exc).split())[:200]}") from None
                     mode = f"scheduler {scheduler}"
                 else:
                     n = workers or min(_machine_cores(), len(groups))

@@ -177,6 +177,15 @@ def test_user_errors(collection, tmp_path, capsys):
         assert fragment in capsys.readouterr().err
     assert cli.main(["batch", str(tmp_path / "nothing*.off"), "-o", str(tmp_path / "x")]) == 2
     assert "no mesh files match" in capsys.readouterr().err
+    import socket
+    with socket.socket() as s:                    # a free loopback port: nobody listens there
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    import dask
+    with dask.config.set({"distributed.comm.timeouts.connect": "2s"}):
+        assert cli.main(["batch", *map(str, good[:6]), "-o", str(tmp_path / "x"), "-q",
+                         "--scheduler", f"tcp://127.0.0.1:{port}"]) == 2
+    assert "cannot connect to the Dask scheduler" in capsys.readouterr().err
     # glob patterns; a missing file is a row, not a crash
     out = tmp_path / "glob"
     assert cli.main(["batch", str(folder / "sub" / "*.off"), str(tmp_path / "missing.off"),
@@ -303,8 +312,7 @@ def test_resume_after_sigint(tmp_path):
 
 # --------------------------------------------------------------------------- loopback cluster
 def _spawn(args, log):
-    return subprocess.Popen(args, stdout=log, stderr=subprocess.STDOUT, start_new_session=True,
-                            env={**os.environ, "DASK_DISTRIBUTED__WORKER__DAEMON": "False"})
+    return subprocess.Popen(args, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
 
 
 def _kill(proc):
