@@ -196,12 +196,7 @@ def _write_vtu(path, V, F, est, *, method, S=None):
 def _writer(fmt):
     from . import mesh_io
     if fmt == "vtu" and ".vtu" not in mesh_io.OUTPUT_EXTENSIONS:
-        return _write_vtu
-    if fmt == "vtu":          # pragma: no cover - once mesh_io writes vtu itself
-        try:
-            import meshio  # noqa: F401
-        except ImportError:
-            raise MeshFileError("--format vtu needs meshio: pip install meshio") from None
+        return _write_vtu          # mesh_io has no vtu writer: ours, via meshio
     return mesh_io.write_curvature
 
 
@@ -261,6 +256,8 @@ class Job:
 
 @dataclass(frozen=True)
 class Options:
+    """What to compute and write for every mesh, and its sandbox limits (see :func:`run_batch`)."""
+
     method: str = "hhj"
     per: str = "vertex"
     radius: int | None = None
@@ -270,6 +267,7 @@ class Options:
 
     @property
     def sandboxed(self):
+        """Run each mesh in a sandbox child process (needed to enforce the limits)."""
         return self.timeout is not None or self.memory_limit is not None
 
 
@@ -673,8 +671,8 @@ class BatchResult:
 
 def _in_process(groups, options, on_row):
     for group in groups:
-        for row in run_group(group, options):
-            on_row(row)
+        for job in group:                 # one by one: progress and Ctrl-C per mesh
+            on_row(run_group([job], options)[0])
 
 
 def _on_dask(client, groups, options, on_row, retry_singles=True):
@@ -801,7 +799,6 @@ def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per
     """
     check_curvature_options(method, per, radius)
     if fmt == "vtu":
-        _writer("vtu")
         try:
             import meshio  # noqa: F401
         except ImportError:

@@ -166,8 +166,12 @@ def test_in_process_formats_and_options(collection, tmp_path, capsys):
             np.testing.assert_allclose(m.point_data[k], r[k], rtol=1e-12)
 
 
-def test_user_errors(collection, tmp_path, capsys):
+def test_user_errors(collection, tmp_path, capsys, monkeypatch):
     folder, good, _ = collection
+    with monkeypatch.context() as m:
+        m.setitem(sys.modules, "meshio", None)           # meshio not installed
+        assert cli.main(["batch", str(good[0]), "-o", str(tmp_path / "x"), "--format", "vtu"]) == 2
+        assert "--format vtu needs meshio: pip install meshio" in capsys.readouterr().err
     for argv, fragment in [(["--method", "igl", "--per", "face"], "per-vertex curvature only"),
                            (["--method", "heine", "--radius", "2"], "--radius applies"),
                            (["--memory-limit", "lots"], "not a positive number of bytes"),
@@ -402,3 +406,36 @@ def test_benchmark_runs_small(tmp_path):
     assert all(t > 0 for t in res["configs"].values()) and len(res["loops"]) == 2
     table = bench.markdown(res)
     assert table.count("\n| ") == 3 and "speed-up over the loop" in table
+
+
+def test_progress_bar_on_a_terminal(collection, tmp_path):
+    """tqdm bar (done, failed, rate) when stderr is a terminal; plain lines are tested above."""
+    pytest.importorskip("tqdm")
+    import fcntl
+    import pty
+    import struct
+    import termios
+    _, good, bad = collection
+    master, slave = pty.openpty()
+    fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 40, 120, 0, 0))
+    files = [str(good[0]), str(next(iter(bad)))]
+    proc = subprocess.Popen(_batch_cmd(*files, "-o", tmp_path / "o"), stdout=slave, stderr=slave,
+                            close_fds=True, start_new_session=True)
+    os.close(slave)
+    out = b""
+    try:
+        while True:
+            try:
+                chunk = os.read(master, 4096)
+            except OSError:                         # EIO: the child closed the terminal
+                break
+            if not chunk:
+                break
+            out += chunk
+        assert proc.wait(timeout=60) == 1
+    finally:
+        os.close(master)
+        _kill(proc)
+    text = out.decode(errors="replace")
+    assert "2/2" in text and "mesh/s" in text and "failed=1" in text
+    assert "[1/2]" not in text                      # no plain lines on a terminal
