@@ -333,7 +333,8 @@ class _Sandbox:
         r_job, w_job = os.pipe()
         r_row, w_row = os.pipe()
         code = f"from igl_hhj.batch import _sandbox_main; _sandbox_main({r_job}, {w_row})"
-        self.proc = subprocess.Popen([sys.executable, "-c", code], pass_fds=(r_job, w_row),
+        env = {k: v for k, v in os.environ.items() if k != "MALLOC_TRIM_THRESHOLD_"}  # see _local_cluster
+        self.proc = subprocess.Popen([sys.executable, "-c", code], pass_fds=(r_job, w_row), env=env,
                                      stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                                      stderr=subprocess.DEVNULL)
         os.close(r_job)
@@ -731,11 +732,16 @@ def _local_cluster(n_workers, retries):
 
 def _start_local_cluster(LocalCluster, dask, n_workers, retries):
     # worker-saturation 1.0: a worker holds only the task it runs, so a worker that dies takes
-    # no queued bystander task's retry budget with it
+    # no queued bystander task's retry budget with it.  MALLOC_TRIM_THRESHOLD_ unset: Dask's
+    # default (65536) turns off glibc's dynamic mmap threshold, every large numpy temporary
+    # then costs fresh pages, and the HHJ solves ran far slower in the workers than in a plain
+    # loop (python -m igl_hhj.benchmarks.batch).  Dashboard / HTTP routes on a free loopback
+    # port (the default :8787 warns when another cluster holds it).
     with dask.config.set({"distributed.scheduler.allowed-failures": retries,
-                          "distributed.scheduler.worker-saturation": 1.0}):
+                          "distributed.scheduler.worker-saturation": 1.0,
+                          "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
         return LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
-                            dashboard_address=None, host="127.0.0.1", memory_limit=0,
+                            dashboard_address="127.0.0.1:0", host="127.0.0.1", memory_limit=0,
                             silence_logs=50)
 
 
