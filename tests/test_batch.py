@@ -315,8 +315,9 @@ def test_resume_after_sigint(tmp_path):
 
 
 # --------------------------------------------------------------------------- loopback cluster
-def _spawn(args, log):
-    return subprocess.Popen(args, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+def _spawn(args, log, env=None):
+    return subprocess.Popen(args, stdout=log, stderr=subprocess.STDOUT, start_new_session=True,
+                            env=env)
 
 
 def _kill(proc):
@@ -346,13 +347,20 @@ def loopback_cluster(tmp_path_factory):
         import json
         address = json.loads(sched_file.read_text())["address"]
         assert address.startswith("tcp://127.0.0.1:")
+        # the worker configuration README "Many meshes" recommends
+        (d / "dask").mkdir()
+        (d / "dask" / "igl-hhj.yaml").write_text(
+            "distributed:\n  nanny:\n    pre-spawn-environ:\n      MALLOC_TRIM_THRESHOLD_: null\n")
+        env = {**os.environ, "DASK_CONFIG": str(d / "dask")}
         workers = [_spawn([dask_cli, "worker", address, "--host", "127.0.0.1", "--nthreads", "1",
-                           "--nworkers", "1", "--no-dashboard", "--name", f"w{i}"], log)
+                           "--nworkers", "1", "--no-dashboard", "--name", f"w{i}"], log, env)
                    for i in range(2)]
         procs += workers
         from distributed import Client
         with Client(address, timeout="30s") as client:
             client.wait_for_workers(2, timeout=90)
+            trim = client.run(lambda: os.environ.get("MALLOC_TRIM_THRESHOLD_"))
+            assert list(trim.values()) == [None, None], trim
         yield address, workers
     finally:
         for p in reversed(procs):
