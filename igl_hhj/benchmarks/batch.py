@@ -13,7 +13,7 @@ written as ascii ``.off``.  The cap keeps the collection in the range where
 4.6 s / 8.9 s of CPU for the subdivided cheburashka / camelhead (53k / 91k faces)
 and would dominate both the collection and the run time.
 
-Measured on the same collection, in this order:
+Measured on the same collection:
 
 * **loop**: ``read_mesh`` → ``TriangleMesh`` → :func:`igl_hhj.batch.compute_curvature`
   → ``write_curvature`` for every file in a plain ``for`` loop (what one would write
@@ -21,11 +21,14 @@ Measured on the same collection, in this order:
 * **in-process**: ``run_batch(workers=0)``;
 * **1 worker**, **2 workers**: ``run_batch`` on an embedded ``LocalCluster``
   (started before the timing; its start-up is reported separately);
+* **overhead**: 20 meshes with ≥ 20k faces, one per task on 1 worker, against the loop
+  on the same meshes: ``(t_worker − t_loop) / t_loop``, and per task
+  ``(wall − Σ in-task seconds) / tasks`` (the time outside the meshes' own work);
 * **grouping**: the small meshes alone on 2 workers, one mesh per task
-  (``group_bytes=0``) and grouped (default :data:`igl_hhj.batch.GROUP_BYTES`);
-* **overhead**: the meshes with ≥ 20k faces on 1 worker against the loop on the same
-  meshes: ``(t_worker − t_loop) / t_loop`` and per task
-  ``(wall − Σ in-task seconds) / tasks``.
+  (``group_bytes=0``) and grouped (default :data:`igl_hhj.batch.GROUP_BYTES`).
+
+The load of a shared machine drifts over minutes, so every configuration runs every
+part of the collection in turn (see :func:`run`).
 
 Prints a markdown table and writes it to ``DIR/batch.md`` (default
 ``./benchmark-results/``).  The speed-up of 2 workers over the loop is bounded by
@@ -123,66 +126,83 @@ def _timed_batch(paths, outdir, **kw):
     return wall, inside
 
 
-def run(n=200, seed=0, mesh_dir=None, workers=(1, 2), workdir=None, progress=True):
-    """Run every measurement; returns a dict of results (seconds, counts, ratios)."""
+def _rotated(items, k):
+    k %= len(items)
+    return items[k:] + items[:k]
+
+
+def run(n=200, seed=0, mesh_dir=None, workers=(1, 2), chunks=4, workdir=None, progress=True):
+    """Run every measurement; returns a dict of results (seconds, counts, ratios).
+
+    The machine is shared, and its load drifts over minutes: the collection is cut into
+    ``chunks`` similar parts (every ``chunks``-th mesh), and each part is run by every
+    configuration in turn, starting with a different one each time; the times are sums
+    over the parts.  The clusters are started once, before the timing.
+    """
     from distributed import Client
 
     from .. import batch
     say = print if progress else (lambda *a, **k: None)
     tmp = Path(workdir) if workdir is not None else Path(tempfile.mkdtemp(prefix="igl_hhj_batch_"))
+    clients = {}
     try:
         coll = make_collection(tmp / "in", n, seed, mesh_dir)
         paths = [p for p, _ in coll]
         faces = np.array([f for _, f in coll])
         small = [p for p, f in coll if f <= 5120]
-        large = [p for p, f in coll if f >= LARGE_FACES]
+        large = [p for p, f in coll if f >= LARGE_FACES][:20]
+        load = os.getloadavg()[0]
         say(f"{n} meshes, {faces.sum()} faces ({faces.min()}–{faces.max()}); {len(small)} small "
-            f"(≤ 5120 faces), {len(large)} with ≥ {LARGE_FACES} faces; load average "
-            f"{os.getloadavg()[0]:.1f} on {batch._machine_cores()} cores")
+            f"(≤ 5120 faces), {len(large)} of those with ≥ {LARGE_FACES} faces for the overhead; "
+            f"load average {load:.1f} on {batch._machine_cores()} cores")
         res = {"meshes": n, "faces": int(faces.sum()), "cores": batch._machine_cores(),
-               "load_before": os.getloadavg()[0], "configs": {}}
-        t_loop = plain_loop(paths, tmp / "loop")
-        res["configs"]["loop"] = t_loop
-        res["loops"] = [t_loop]
-        say(f"  loop           {t_loop:7.1f} s")
-        wall, _ = _timed_batch(paths, tmp / "inproc", workers=0)
-        res["configs"]["in-process"] = wall
-        say(f"  in-process     {wall:7.1f} s")
+               "load_before": load, "chunks": chunks}
         for w in workers:
             t = time.perf_counter()
             cluster = batch._local_cluster(w, 2)
-            client = Client(cluster)
+            clients[w] = (Client(cluster), cluster)
             res[f"startup_{w}"] = time.perf_counter() - t
-            try:
-                wall, _ = _timed_batch(paths, tmp / f"w{w}", client=client)
-                res["configs"][f"{w} worker{'s' if w > 1 else ''}"] = wall
-                say(f"  {w} worker(s)    {wall:7.1f} s   (cluster start-up {res[f'startup_{w}']:.1f} s)")
-                if w == max(workers) and small:
-                    g0, _ = _timed_batch(small, tmp / "g0", client=client, group_bytes=0)
-                    g1, _ = _timed_batch(small, tmp / "g1", client=client)
-                    res["grouping"] = {"meshes": len(small), "single": g0, "grouped": g1}
-                    say(f"  {len(small)} small meshes, {w} workers: one per task {g0:.2f} s, "
-                        f"grouped {g1:.2f} s")
-                if w == 1 and large:
-                    large = large[:20]
-                    tl = plain_loop(large, tmp / "loop_large")
-                    wall_l, inside = _timed_batch(large, tmp / "w1_large", client=client,
-                                                  group_bytes=0)
-                    res["overhead"] = {"meshes": len(large), "loop": tl, "worker": wall_l,
-                                       "inside": inside}
-                    say(f"  {len(large)} meshes ≥ {LARGE_FACES} faces: loop {tl:.2f} s, 1 worker "
-                        f"{wall_l:.2f} s, in tasks {inside:.2f} s")
-            finally:
-                client.close()
-                cluster.close()
-        # the loop once more, last: the load of a shared machine drifts; keep the faster loop
-        t_loop = plain_loop(paths, tmp / "loop")
-        res["loops"].append(t_loop)
-        res["configs"]["loop"] = min(res["loops"])
-        say(f"  loop again     {t_loop:7.1f} s")
+
+        def measure(name, part, out):
+            if name == "loop":
+                return plain_loop(part, out), None
+            if name == "in-process":
+                return _timed_batch(part, out, workers=0)
+            w, _, grouping = name.partition(" ")
+            kw = {"group_bytes": 0} if grouping == "single" else {}
+            return _timed_batch(part, out, client=clients[int(w)][0], **kw)
+
+        def interleaved(names, subset, parts, tag):
+            wall = dict.fromkeys(names, 0.0)
+            inside = dict.fromkeys(names, 0.0)
+            for c in range(parts):
+                part = subset[c::parts]
+                for name in _rotated(list(names), c):
+                    t, t_in = measure(name, part, tmp / f"{tag}_{name.replace(' ', '_')}")
+                    wall[name] += t
+                    inside[name] += t_in or 0.0
+                say(f"  [{tag} {c + 1}/{parts}] " + ", ".join(f"{k} {v:.1f} s" for k, v in wall.items()))
+            return wall, inside
+
+        names = ["loop", "in-process"] + [str(w) for w in workers]
+        wall, _ = interleaved(names, paths, chunks, "all")
+        res["configs"] = {("loop" if k == "loop" else "in-process" if k == "in-process" else
+                           f"{k} worker{'s' if int(k) > 1 else ''}"): v for k, v in wall.items()}
+        if 1 in clients and large:
+            wall, inside = interleaved(["loop", "1 single"], large, 2, "large")
+            res["overhead"] = {"meshes": len(large), "loop": wall["loop"], "worker": wall["1 single"],
+                               "inside": inside["1 single"]}
+        wmax = max(workers)
+        if small:
+            wall, _ = interleaved([f"{wmax} single", str(wmax)], small, 2, "small")
+            res["grouping"] = {"meshes": len(small), "workers": wmax,
+                               "single": wall[f"{wmax} single"], "grouped": wall[str(wmax)]}
         res["load_after"] = os.getloadavg()[0]
         return res
     finally:
+        for client, cluster in reversed(list(clients.values())):   # LIFO: log levels restored last
+            client.close()
+            cluster.close()
         if workdir is None:
             shutil.rmtree(tmp, ignore_errors=True)
 
@@ -194,8 +214,8 @@ def markdown(res):
              "|---|---:|---:|---:|---:|"]
     for name, t in res["configs"].items():
         lines.append(f"| {name} | {t:.1f} s | {n / t:.1f} | {nf / t / 1e3:.0f}k | {loop / t:.2f}× |")
-    notes = [f"loop: the faster of {len(res['loops'])} runs (first and last: "
-             + " / ".join(f"{t:.1f} s" for t in res["loops"]) + ")",
+    notes = [f"times summed over {res['chunks']} interleaved parts of the collection (each part "
+             "run by every configuration in turn, rotating the order)",
              f"{n} meshes, {nf / 1e6:.2f}M faces, {res['cores']} cores, load average "
              f"{res['load_before']:.1f} before / {res['load_after']:.1f} after (other jobs on the "
              "machine); cluster start-up (not in the times): "
@@ -210,7 +230,7 @@ def markdown(res):
                      f"({100 * (o['worker'] - o['inside']) / o['inside']:.1f} %)")
     if "grouping" in res:
         g = res["grouping"]
-        notes.append(f"{g['meshes']} small meshes (≤ 5120 faces) on 2 workers: one mesh per task "
+        notes.append(f"{g['meshes']} small meshes (≤ 5120 faces) on {g['workers']} workers: one mesh per task "
                      f"{g['meshes'] / g['single']:.0f} meshes/s, grouped "
                      f"{g['meshes'] / g['grouped']:.0f} meshes/s")
     return "\n".join(lines) + "\n\n" + "\n".join(f"- {s}" for s in notes) + "\n"
