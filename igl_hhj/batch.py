@@ -89,10 +89,11 @@ GROUP_MAX = 16
 
 PERCENTILES = (1, 50, 99)
 QUANTITIES = ("k1", "k2", "H", "K")
-SUMMARY_COLUMNS = (["path", "output", "status", "vertices", "faces", "seconds", "peak_memory",
-                    "error"]
+SUMMARY_COLUMNS = (["path", "output", "status", "vertices", "faces", "seconds", "cpu_seconds",
+                    "peak_memory", "error"]
                    + [f"{q}_p{p:02d}" for q in QUANTITIES for p in PERCENTILES] + ["nan_values"])
-"""Columns of ``summary.csv``: ``peak_memory`` in bytes (the process's peak resident
+"""Columns of ``summary.csv``: ``seconds`` wall-clock and ``cpu_seconds`` CPU time (all threads
+of the process computing the mesh) from reading to writing; ``peak_memory`` in bytes (the process's peak resident
 set during the mesh, Linux only, empty when unknown or when the worker runs several
 threads); ``k1_p01 ... K_p99`` the 1st/50th/99th percentiles over the vertices or
 faces; ``nan_values`` the number of elements without a value."""
@@ -285,7 +286,7 @@ def process_mesh(job, options, measure_peak=True):
     """
     from .mesh import TriangleMesh
     from .mesh_io import read_mesh
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     peak = measure_peak and _reset_peak_memory()
     extra = {}
     try:
@@ -310,7 +311,8 @@ def process_mesh(job, options, measure_peak=True):
         status, message = "error", msg if msg.startswith(job.path) else f"{job.path}: {msg}"
     if peak:
         extra["peak_memory"] = _proc_status_bytes("VmHWM")
-    return _row(job, status, seconds=round(time.perf_counter() - t0, 4), error=message, **extra)
+    return _row(job, status, seconds=round(time.perf_counter() - t0, 4),
+                cpu_seconds=round(time.process_time() - c0, 4), error=message, **extra)
 
 
 # --------------------------------------------------------------------------- sandbox
@@ -543,7 +545,7 @@ def _skipped_row(job, previous):
     row = _row(job, "skipped")
     if old is not None and old.get("status") in ("ok", "skipped") and old.get("faces"):
         for c in SUMMARY_COLUMNS[3:]:
-            if c not in ("seconds", "peak_memory", "error") and old.get(c) not in (None, ""):
+            if c not in ("seconds", "cpu_seconds", "peak_memory", "error") and old.get(c) not in (None, ""):
                 row[c] = old[c]
     elif job.output.endswith(".npz"):    # finished by a worker after the interrupt reached us
         try:

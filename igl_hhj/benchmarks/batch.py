@@ -99,22 +99,23 @@ def make_collection(folder, n=200, seed=0, mesh_dir=None):
 
 
 def plain_loop(paths, outdir):
-    """The loop without igl_hhj.batch; returns seconds."""
+    """The loop without igl_hhj.batch; returns (wall seconds, CPU seconds of all threads)."""
     from ..batch import compute_curvature
     from ..mesh import TriangleMesh
     from ..mesh_io import read_mesh, write_curvature
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
-    t = time.perf_counter()
+    t, c = time.perf_counter(), time.process_time()
     for p in paths:
         V, F, _ = read_mesh(p)
         mesh = TriangleMesh(V, F)
         est, S = compute_curvature(mesh.V, mesh.F, keep_shape_operator=True)
         write_curvature(outdir / (Path(p).stem + ".npz"), mesh.V, mesh.F, est, method="hhj", S=S)
-    return time.perf_counter() - t
+    return time.perf_counter() - t, time.process_time() - c
 
 
 def _timed_batch(paths, outdir, **kw):
+    """(wall seconds, Σ in-task seconds, Σ in-task CPU seconds) of one ``run_batch``."""
     from ..batch import run_batch
     t = time.perf_counter()
     res = run_batch([str(p) for p in paths], outdir, resume=False, progress=False, **kw)
@@ -122,8 +123,12 @@ def _timed_batch(paths, outdir, **kw):
     bad = [r for r in res.rows if r["status"] != "ok"]
     if bad:
         raise RuntimeError(f"benchmark meshes failed: {bad[:2]}")
-    inside = sum(float(r["seconds"]) for r in res.rows)
-    return wall, inside
+    return (wall, sum(float(r["seconds"]) for r in res.rows),
+            sum(float(r["cpu_seconds"]) for r in res.rows))
+
+
+def _label(name):
+    return name if name in ("loop", "in-process") else f"{name} worker{'s' if int(name) > 1 else ''}"
 
 
 def _rotated(items, k):
@@ -165,7 +170,8 @@ def run(n=200, seed=0, mesh_dir=None, workers=(1, 2), chunks=4, workdir=None, pr
 
         def measure(name, part, out):
             if name == "loop":
-                return plain_loop(part, out), None
+                wall, cpu = plain_loop(part, out)
+                return wall, None, cpu
             if name == "in-process":
                 return _timed_batch(part, out, workers=0)
             w, _, grouping = name.partition(" ")
@@ -173,28 +179,28 @@ def run(n=200, seed=0, mesh_dir=None, workers=(1, 2), chunks=4, workdir=None, pr
             return _timed_batch(part, out, client=clients[int(w)][0], **kw)
 
         def interleaved(names, subset, parts, tag):
-            wall = dict.fromkeys(names, 0.0)
-            inside = dict.fromkeys(names, 0.0)
+            wall, inside, cpu = (dict.fromkeys(names, 0.0) for _ in range(3))
             for c in range(parts):
                 part = subset[c::parts]
                 for name in _rotated(list(names), c):
-                    t, t_in = measure(name, part, tmp / f"{tag}_{name.replace(' ', '_')}")
+                    t, t_in, t_cpu = measure(name, part, tmp / f"{tag}_{name.replace(' ', '_')}")
                     wall[name] += t
                     inside[name] += t_in or 0.0
+                    cpu[name] += t_cpu
                 say(f"  [{tag} {c + 1}/{parts}] " + ", ".join(f"{k} {v:.1f} s" for k, v in wall.items()))
-            return wall, inside
+            return wall, inside, cpu
 
         names = ["loop", "in-process"] + [str(w) for w in workers]
-        wall, _ = interleaved(names, paths, chunks, "all")
-        res["configs"] = {("loop" if k == "loop" else "in-process" if k == "in-process" else
-                           f"{k} worker{'s' if int(k) > 1 else ''}"): v for k, v in wall.items()}
+        wall, _, cpu = interleaved(names, paths, chunks, "all")
+        res["cpu"] = cpu
+        res["configs"] = {_label(k): v for k, v in wall.items()}
         if 1 in clients and large:
-            wall, inside = interleaved(["loop", "1 single"], large, 2, "large")
+            wall, inside, _ = interleaved(["loop", "1 single"], large, 2, "large")
             res["overhead"] = {"meshes": len(large), "loop": wall["loop"], "worker": wall["1 single"],
                                "inside": inside["1 single"]}
         wmax = max(workers)
         if small:
-            wall, _ = interleaved([f"{wmax} single", str(wmax)], small, 2, "small")
+            wall, _, _ = interleaved([f"{wmax} single", str(wmax)], small, 2, "small")
             res["grouping"] = {"meshes": len(small), "workers": wmax,
                                "single": wall[f"{wmax} single"], "grouped": wall[str(wmax)]}
         res["load_after"] = os.getloadavg()[0]
@@ -216,6 +222,9 @@ def markdown(res):
         lines.append(f"| {name} | {t:.1f} s | {n / t:.1f} | {nf / t / 1e3:.0f}k | {loop / t:.2f}× |")
     notes = [f"times summed over {res['chunks']} interleaved parts of the collection (each part "
              "run by every configuration in turn, rotating the order)",
+             "CPU seconds for the whole collection (loop: the process, all threads; the others: "
+             "the sum of the meshes' cpu_seconds): "
+             + ", ".join(f"{_label(k)} {v:.1f} s" for k, v in res["cpu"].items()),
              f"{n} meshes, {nf / 1e6:.2f}M faces, {res['cores']} cores, load average "
              f"{res['load_before']:.1f} before / {res['load_after']:.1f} after (other jobs on the "
              "machine); cluster start-up (not in the times): "
