@@ -82,7 +82,7 @@ IN_PROCESS_MAX_FILES = 4
 GROUP_BYTES = 400_000
 """Consecutive input files are grouped into one Dask task until their sizes add up to
 this many bytes (about 8k faces of ascii OFF); larger files are one task each.
-Chosen from ``python -m igl_hhj.benchmarks.batch`` (see README, "Many meshes")."""
+``python -m igl_hhj.benchmarks.batch`` compares it with one mesh per task (README, "Many meshes")."""
 
 GROUP_MAX = 16
 """At most this many meshes per task."""
@@ -92,11 +92,12 @@ QUANTITIES = ("k1", "k2", "H", "K")
 SUMMARY_COLUMNS = (["path", "output", "status", "vertices", "faces", "seconds", "cpu_seconds",
                     "peak_memory", "error"]
                    + [f"{q}_p{p:02d}" for q in QUANTITIES for p in PERCENTILES] + ["nan_values"])
-"""Columns of ``summary.csv``: ``seconds`` wall-clock and ``cpu_seconds`` CPU time (all threads
-of the process computing the mesh) from reading to writing; ``peak_memory`` in bytes (the process's peak resident
-set during the mesh, Linux only, empty when unknown or when the worker runs several
-threads); ``k1_p01 ... K_p99`` the 1st/50th/99th percentiles over the vertices or
-faces; ``nan_values`` the number of elements without a value."""
+"""Columns of ``summary.csv``: ``seconds`` wall-clock and ``cpu_seconds`` CPU time (all
+threads of the process computing the mesh) from reading to writing; ``peak_memory`` in
+bytes (the process's peak resident set during the mesh, Linux only, empty when unknown
+or when the worker runs several threads); ``k1_p01 ... K_p99`` the 1st/50th/99th
+percentiles over the vertices or faces; ``nan_values`` the number of elements without a
+value."""
 
 TMP_MARK = ".igl-hhj-tmp"
 

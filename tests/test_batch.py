@@ -97,6 +97,8 @@ def check_rows(outdir, good, bad, fmt="npz"):
         out = Path(r["output"])
         assert out.suffix == "." + fmt and out.is_file()
         assert int(r["faces"]) > 0 and float(r["k1_p50"]) >= float(r["k2_p50"])
+        if r["status"] == "ok":
+            assert 0 < float(r["cpu_seconds"]) and 0 < float(r["seconds"])
     for p, fragment in bad.items():
         r = rows[str(p)]
         assert r["status"] == "error" and fragment in r["error"], r
