@@ -12,6 +12,10 @@ Commands
     or screenshot.
 ``igl-hhj info MESH``
     what the mesh is made of and whether igl_hhj accepts it.
+``igl-hhj batch INPUT... -o OUTDIR``
+    ``curvature -o`` for many meshes on an embedded or existing Dask cluster
+    (:mod:`igl_hhj.batch`); exit 1 when some meshes failed (rows in
+    ``OUTDIR/summary.csv``).
 
 Exit codes
 ----------
@@ -58,11 +62,6 @@ EGL_HINT = ("headless rendering needs EGL; on Debian/Ubuntu: "
             "apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri")
 LARGE_MESH_FACES = 100_000
 """Meshes with more faces get stage-by-stage progress lines on stderr."""
-
-# (method, per) -> igl_hhj.baselines estimator
-ESTIMATORS = {("hhj", "vertex"): "hhj_vertex", ("hhj", "face"): "hhj_face",
-              ("igl", "vertex"): "libigl_quadric", ("heine", "vertex"): "heine"}
-METHOD_LABELS = {"hhj": "HHJ solve", "igl": "libigl quadric fit", "heine": "Heine P1 solve"}
 
 
 class UserError(Exception):
@@ -231,15 +230,16 @@ def _first_line(exc):
 
 # --------------------------------------------------------------------------- curvature
 def _curvature(args):
-    from . import baselines
+    from .batch import check_curvature_options, compute_curvature, default_radius
     from .mesh import TriangleMesh
 
     say = _say(args)
 
     per = args.per
-    if args.method != "hhj" and per == "face":
-        raise UserError(f"--method {args.method} computes per-vertex curvature only; "
-                        f"use --per vertex (or --method hhj for per-face values)")
+    try:
+        check_curvature_options(args.method, per, args.radius)
+    except ValueError as exc:
+        raise UserError(str(exc)) from None
     if not 0 <= args.robust < 50:
         raise UserError(f"--robust must be a percentile in [0, 50), got {args.robust}")
     if args.out is not None:
@@ -258,35 +258,18 @@ def _curvature(args):
                         f"(run 'igl-hhj info {args.mesh}' for a diagnosis)") from None
     t_read = time.perf_counter() - t
     large = mesh.n_faces > LARGE_MESH_FACES and not args.quiet
-    keep_S = args.method == "hhj" and args.out is not None and Path(args.out).suffix.lower() == ".npz"
-    n_stages = 2 + keep_S + (args.out is not None) + (args.screenshot is not None)
+    keep_S = args.out is not None and Path(args.out).suffix.lower() == ".npz"
+    n_stages = (2 + (keep_S and args.method == "hhj") + (args.out is not None)
+                + (args.screenshot is not None))
     stages = _Stages(n_stages, large)
     stages.done(f"reading and validating {mesh.n_faces} faces", t_read)
 
-    if args.radius is not None and (isinstance(args.radius, bool) or args.radius < 0
-                                    or (args.radius == 0 and not (args.method == "hhj" and per == "face"))):
-        raise UserError(f"--radius must be a positive integer (0 only with --per face), got {args.radius}")
-    if args.method == "heine" and args.radius is not None:
-        raise UserError("--radius applies to --method hhj and igl, not heine")
-    radius = args.radius if args.radius is not None else (0 if per == "face" else 5)
-    scale = {"smoothing": radius} if per == "face" else {"radius": radius}
+    radius = args.radius if args.radius is not None else default_radius(args.method, per)
 
     t = time.perf_counter()
-    S = None
-    if keep_S:        # solve once, keep S_h for the npz, derive the curvatures from it
-        from .curvature import shape_operator
-        S = stages.run(f"{METHOD_LABELS[args.method]} (shape operator)", shape_operator, mesh.V, mesh.F)
-        hhj = baselines.hhj_face if per == "face" else baselines.hhj_vertex
-        est = stages.run(f"curvatures ({per})", hhj, mesh.V, mesh.F, shape_operator=S, **scale)
-    elif args.method == "hhj":
-        hhj = baselines.hhj_face if per == "face" else baselines.hhj_vertex
-        est = stages.run(f"{METHOD_LABELS[args.method]} ({per})", hhj, mesh.V, mesh.F, **scale)
-    elif args.method == "igl":
-        est = stages.run(f"{METHOD_LABELS[args.method]} ({per})", baselines.libigl_quadric,
-                         mesh.V, mesh.F, radius=radius)
-    else:
-        est = stages.run(f"{METHOD_LABELS[args.method]} ({per})",
-                         baselines.estimate, ESTIMATORS[args.method, per], mesh.V, mesh.F)
+    est, S = compute_curvature(mesh.V, mesh.F, method=args.method, per=per,
+                               radius=args.radius,
+                               keep_shape_operator=keep_S, run=stages.run)
     dt = time.perf_counter() - t
 
     say(f"{args.mesh}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, "
@@ -361,6 +344,48 @@ def _write(stages, args, mesh, est, S):
     _say(args)(f"  wrote {args.out}")
 
 
+# --------------------------------------------------------------------------- batch
+def _memory_bytes(text):
+    """``2000000000``, ``2e9``, ``512M``, ``4G``, ``1.5GiB`` -> bytes."""
+    import re
+    m = re.fullmatch(r"\s*([0-9.eE+]+)\s*([kKmMgGtT]?)(i?[bB])?\s*", text)
+    try:
+        value = float(m.group(1)) if m else None
+    except ValueError:
+        value = None
+    if value is None or not value > 0:
+        raise argparse.ArgumentTypeError(f"not a positive number of bytes: {text!r} (e.g. 4G)")
+    base = 1024 if m.group(3) and m.group(3).lower() == "ib" else 1000
+    return int(value * base ** " kmgt".index(m.group(2).lower() or " "))
+
+
+def _batch(args):
+    from . import batch
+    if args.workers is not None and args.workers < 0:
+        raise UserError(f"--workers must be at least 0, got {args.workers}")
+    try:
+        result = batch.run_batch(args.inputs, args.out, scheduler=args.scheduler,
+                                 workers=args.workers, method=args.method, per=args.per,
+                                 radius=args.radius, fmt=args.format, resume=args.resume,
+                                 timeout=args.timeout, memory_limit=args.memory_limit,
+                                 progress=not args.quiet,
+                                 group_bytes=(batch.GROUP_BYTES if args.group_bytes is None
+                                              else args.group_bytes))
+    except (ValueError, ImportError) as exc:
+        raise UserError(str(exc)) from None
+    except OSError as exc:
+        raise UserError(f"{args.out}: {exc.strerror or exc}") from None
+    c = result.counts()
+    of = f" of {result.total}" if len(result.rows) < result.total else ""
+    print(f"{len(result.rows)}{of} meshes: {c['ok']} ok, {c['error']} error, {c['timeout']} timeout, "
+          f"{c['skipped']} skipped in {result.seconds:.1f} s ({result.mode}); "
+          f"summary {result.summary_files[0]}")
+    if result.interrupted:
+        print("igl-hhj: interrupted (rerun the same command to continue)", file=sys.stderr)
+        return 130
+    return 0 if c["error"] + c["timeout"] == 0 else 1
+
+
 # --------------------------------------------------------------------------- info
 def _info(args):
     from .mesh_report import mesh_report
@@ -408,6 +433,16 @@ def _named_demo(argv):
     if len(argv) >= 2 and argv[0] == "demo" and argv[1] in DEMOS:
         return run(argv[1], argv[2:], prog=f"igl-hhj demo {argv[1]}")
     return None
+
+
+def batch_formats():
+    from .batch import FORMATS
+    return FORMATS
+
+
+def batch_group_bytes():
+    from .batch import GROUP_BYTES
+    return GROUP_BYTES
 
 
 def build_parser():
@@ -477,6 +512,42 @@ def build_parser():
                    help=f"print nothing but warnings and errors: no summary on stdout, no progress "
                         f"lines (stderr, meshes > {LARGE_MESH_FACES} faces)")
     c.set_defaults(func=_curvature)
+
+    b = sub.add_parser("batch", help="curvature of many mesh files, in parallel (Dask)",
+                       description="igl-hhj curvature -o for every mesh in INPUT (files, folders "
+                                   "searched recursively, glob patterns): OUTDIR/<relative "
+                                   "path>.FORMAT and OUTDIR/summary.csv (+ summary.parquet with "
+                                   "pyarrow). Embedded Dask cluster by default (in-process for a "
+                                   "handful of files), or an existing one with --scheduler.",
+                       epilog="exit codes: 0 all ok/skipped, 1 some meshes failed (see "
+                              "summary.csv), 2 user error, 130 interrupted (rerun to resume)")
+    b.add_argument("inputs", nargs="+", metavar="INPUT")
+    b.add_argument("-o", "--out", required=True, metavar="OUTDIR", help="output folder")
+    b.add_argument("--scheduler", metavar="ADDRESS",
+                   help="Dask scheduler to use, e.g. tcp://10.0.0.1:8786 (default: embedded cluster)")
+    b.add_argument("--workers", type=int, metavar="N",
+                   help="worker processes of the embedded cluster (default: number of cores; "
+                        "0: in-process)")
+    b.add_argument("--method", choices=["hhj", "igl", "heine"], default="hhj",
+                   help="as for 'igl-hhj curvature' (default hhj)")
+    b.add_argument("--per", choices=["face", "vertex"], default="vertex",
+                   help="as for 'igl-hhj curvature' (default vertex)")
+    b.add_argument("--radius", type=int, metavar="R",
+                   help="as for 'igl-hhj curvature': hhj smoothing scale (default 5 per vertex, 0 per face), igl k-ring")
+    b.add_argument("--format", choices=list(batch_formats()), default="npz",
+                   help="npz (default; same content as 'igl-hhj curvature -o X.npz'), ply, or "
+                        "vtu (needs meshio)")
+    b.add_argument("--resume", action=argparse.BooleanOptionalAction, default=True,
+                   help="skip inputs whose output is newer than the input (default on)")
+    b.add_argument("--timeout", type=float, metavar="S",
+                   help="seconds per mesh (status timeout when exceeded)")
+    b.add_argument("--memory-limit", type=_memory_bytes, metavar="BYTES",
+                   help="resident memory per mesh, e.g. 4G (status error when exceeded)")
+    b.add_argument("--group-bytes", type=int, default=None, metavar="N",
+                   help="group small input files into one task up to N bytes in total "
+                        "(default %d; 0: one mesh per task)" % batch_group_bytes())
+    b.add_argument("-q", "--quiet", action="store_true", help="no progress bar / lines")
+    b.set_defaults(func=_batch)
 
     i = sub.add_parser("info", help="mesh statistics and whether igl_hhj accepts the mesh",
                        description="Vertices, faces, edges, components, boundary loops, Euler "
