@@ -42,7 +42,7 @@ from .surface import ElementGeometry, LagrangeSurface
 
 __all__ = ["CurvedHHJ", "reference_tensors"]
 
-CHUNK = 8192   # faces per vectorised batch (bounds the memory of the (faces × points × basis) arrays)
+CHUNK = 4096   # faces per vectorised batch (bounds the memory of the (faces × points × basis) arrays)
 
 
 def _sym_outer(u, v):
@@ -153,8 +153,8 @@ class CurvedHHJ:
         Sig = self._per_point_basis(xi)                              # (n, nb, 2, 2)
         c = np.asarray(coeffs)[self.dofs[faces]] * self.scale[faces][:, :, None]   # (n, nb, k)
         Sh = np.einsum("nbk,nbde->nkde", c, Sig)
-        J = g.J[:, 0]
-        return np.einsum("nid,nkde,nje->nkij", J, Sh, J) / g.detG[:, 0, None, None, None]
+        J = g.J[:, 0][:, None]                                       # (n, 1, 3, 2)
+        return (J @ Sh @ J.swapaxes(-1, -2)) / g.detG[:, 0, None, None, None]
 
     def _per_point_basis(self, xi):
         L = np.ones((len(xi), 1)) if self.r == 0 else self.scalar.values(xi)
@@ -204,13 +204,18 @@ class CurvedHHJ:
             fs = slice(f0, min(f0 + CHUNK, surf.n_faces))
             X = surf.nodes[surf.elements[fs]]
             g = ElementGeometry(X, xi, self.m, second=True)
-            GS = np.einsum("fqde,qbec->fqbdc", g.G, Sig)              # G Σ̂_b
+            nf, q = g.detG.shape
+            GS = g.G[:, :, None] @ Sig[None]                           # (f, q, nb, 2, 2): G Σ̂_b
             wA = w[None] / g.detG ** 1.5
-            Aloc = np.einsum("fq,fqbde,fqced->fbc", wA, GS, GS)
+            P = (GS * wA[:, :, None, None, None]).transpose(0, 2, 1, 3, 4).reshape(nf, nb, 4 * q)
+            Q = GS.swapaxes(-1, -2).transpose(0, 2, 1, 3, 4).reshape(nf, nb, 4 * q)
+            Aloc = P @ Q.swapaxes(1, 2)                                # Σ_q w tr(GΣ̂_b GΣ̂_c)/detG^1.5
             # Christoffel symbols Γ^γ_{αβ} = G^{γδ} X_δ · X_{αβ}, covariant Hessian of N_a
-            Gam = np.einsum("fqgd,fqkd,fqkab->fqgab", g.Ginv, g.J, g.X2)
-            Hc = g.d2N[None] - np.einsum("fqgab,qng->fqnab", Gam, g.dN)
-            Bloc = -np.einsum("fq,qbde,fqned->fbn", w[None] / g.sqrt_detG, Sig, Hc)
+            Gam = (g.Ginv @ g.J.swapaxes(-1, -2)) @ g.X2.reshape(nf, q, 3, 4)     # (f, q, 2, 4)
+            Hc = g.d2N.reshape(1, q, nn_, 4) - g.dN[None] @ Gam                   # (f, q, n, 4)
+            Hc *= (w[None] / g.sqrt_detG)[:, :, None, None]
+            SigF = Sig.transpose(1, 0, 2, 3).reshape(nb, q * 4)
+            Bloc = -(SigF @ Hc.transpose(0, 1, 3, 2).reshape(nf, q * 4, nn_))    # (f, nb, n)
             for j in range(3):                                       # 3 local edges
                 ge = ElementGeometry(X, edge_xi[j], self.m)
                 sp_ = np.einsum("fgkd,d->fgk", ge.J, EDGE_TANGENTS[j])
@@ -218,7 +223,7 @@ class CurvedHHJ:
                 a = np.einsum("fgde,e->fgd", ge.Ginv, EDGE_OUTWARD[j])
                 dv = np.einsum("fgd,gnd->fgn", a, ge.dN)             # (G⁻¹ t̂^⊥)·∇_ξ N_a
                 fac = wg[None] * ge.sqrt_detG / speed2
-                Bloc += np.einsum("fg,gb,fgn->fbn", fac, edge_nn[j], dv)
+                Bloc += edge_nn[j].T @ (fac[:, :, None] * dv)
             sc = self.scale[fs]
             Aloc *= sc[:, :, None] * sc[:, None, :]
             Bloc *= sc[:, :, None]
@@ -230,7 +235,6 @@ class CurvedHHJ:
             rowsB.append(np.broadcast_to(D[:, :, None], Bloc.shape).ravel())
             colsB.append(np.broadcast_to(Ni[:, None, :], Bloc.shape).ravel())
             valsB.append(Bloc.ravel())
-        del nn_
         A = sp.coo_matrix((np.concatenate(valsA), (np.concatenate(rowsA), np.concatenate(colsA))),
                           shape=(self.n_dofs, self.n_dofs)).tocsr()
         B = sp.coo_matrix((np.concatenate(valsB), (np.concatenate(rowsB), np.concatenate(colsB))),

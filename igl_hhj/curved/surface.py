@@ -166,7 +166,10 @@ class LagrangeSurface:
         ok = np.isfinite(g.detG) & (g.detG > 0)
         l2 = self.mesh.edge_lengths.max(axis=1) ** 2
         ok &= g.detG > (1e-12 * l2[:, None]) ** 2
-        ok &= np.einsum("fqk,fk->fq", np.nan_to_num(g.nu), flat) > 0
+        # inverted: the curved normal at the centroid turns against the corner triangle's
+        # (elsewhere a coarse element of a strongly curved surface may legitimately exceed 90°)
+        gc = ElementGeometry(self.nodes[self.elements], np.array([[1 / 3, 1 / 3]]), self.order)
+        ok &= (np.einsum("fqk,fk->fq", np.nan_to_num(gc.nu), flat) > 0)
         if not ok.all():
             f = int(np.flatnonzero(~ok.all(1))[0])
             raise ValueError(f"element {f} is degenerate or folds over (its Jacobian vanishes or its "
