@@ -20,7 +20,7 @@ import numpy as np
 from ..mesh import TriangleMesh
 from .reference import edge_node_slots, lagrange_basis, line_quadrature, triangle_quadrature
 
-__all__ = ["projected_nodes", "edge_moment_matrices"]
+__all__ = ["projected_nodes", "mapped_nodes", "edge_moment_matrices"]
 
 
 def _lagrange_1d(order, t):
@@ -50,37 +50,70 @@ def projected_nodes(V, F, order, project, interpolant="walker"):
     """Nodes and gmsh-ordered elements of Γ^m from a flat mesh and a map ``project``.
 
     See :meth:`igl_hhj.curved.LagrangeSurface.from_projection`."""
+    if not callable(project):
+        raise TypeError("project must be a callable mapping (n, 3) points onto the surface")
+    mesh = TriangleMesh(V, F)
+    X = mesh.V[mesh.F]
+
+    def element_map(faces, bary):
+        return project(np.einsum("nc,nck->nk", bary, X[faces]))
+    return mapped_nodes(mesh, order, element_map, interpolant)
+
+
+def mapped_nodes(mesh, order, element_map, interpolant="walker"):
+    """Nodes and elements of Γ^m for an element map ``element_map(faces, bary) -> (n, 3)``:
+    the exact map F_T of Walker §3.1 from the flat triangles of ``mesh`` onto Γ
+    (continuous across edges), interpolated by 𝓘_h^{1,m} (eq. 4.14) or nodally."""
     if order not in (1, 2, 3):
         raise ValueError(f"order must be 1, 2 or 3, got {order!r}")
     if interpolant not in ("walker", "nodal"):
         raise ValueError(f"interpolant must be 'walker' or 'nodal', got {interpolant!r}")
-    if not callable(project):
-        raise TypeError("project must be a callable mapping (n, 3) points onto the surface")
-    mesh = TriangleMesh(V, F)
-    Vf, Ff = mesh.V, mesh.F
+    if not callable(element_map):
+        raise TypeError("the element map must be callable (faces, bary) -> points")
+    Ff = mesh.F
 
-    def proj(X):
-        Y = np.asarray(project(np.asarray(X, dtype=np.float64)), dtype=np.float64)
-        if Y.shape != X.shape:
-            raise ValueError(f"project returned shape {Y.shape} for input of shape {X.shape}")
+    def fmap(faces, bary):
+        Y = np.asarray(element_map(faces, bary), dtype=np.float64)
+        if Y.shape != (len(faces), 3):
+            raise ValueError(f"project returned shape {Y.shape} for input of shape {(len(faces), 3)}")
         if not np.isfinite(Y).all():
             raise ValueError("project returned NaN or inf")
         return Y
 
-    nV, nE, nF = len(Vf), mesh.n_edges, mesh.n_faces
-    Pv = proj(Vf)
+    nV, nE, nF = mesh.n_vertices, mesh.n_edges, mesh.n_faces
+    # vertices: image of each vertex through one of its faces
+    vf = np.zeros(nV, dtype=np.int64)
+    vc = np.zeros(nV, dtype=np.int64)
+    vf[Ff.ravel()] = np.repeat(np.arange(nF), 3)
+    vc[Ff.ravel()] = np.tile(np.arange(3), nF)
+    ref = mesh.referenced_vertices
+    Pv = np.array(mesh.V, dtype=np.float64)
+    Pv[ref] = fmap(vf[ref], np.eye(3)[vc[ref]])
     if order == 1:
         return Pv, Ff.copy()
     E = mesh.edges
-    A, B = Vf[E[:, 0]], Vf[E[:, 1]]
+    ef, li = mesh.edge_faces, mesh.edge_local_index
+    col = (ef[:, 0] < 0).astype(int)
+    fe, je = ef[np.arange(nE), col], li[np.arange(nE), col]
+    fwd = E[:, 0] == Ff[fe, (je + 1) % 3]
+
+    def edge_bary(t):                       # (nE, len(t), 3) barycentrics of edge points va → vb
+        B = np.zeros((nE, len(t), 3))
+        a, b = (je + 1) % 3, (je + 2) % 3
+        ta = np.where(fwd[:, None], 1 - t[None], t[None])
+        r = np.arange(nE)[:, None]
+        B[r, np.arange(len(t))[None], a[:, None]] = ta
+        B[r, np.arange(len(t))[None], b[:, None]] = 1 - ta
+        return B
+
+    def map_edges(t):
+        Bt = edge_bary(t)
+        return fmap(np.repeat(fe, len(t)), Bt.reshape(-1, 3)).reshape(nE, len(t), 3)
     if interpolant == "nodal":
-        s = np.arange(1, order) / order
-        pts = A[:, None] + s[None, :, None] * (B - A)[:, None]
-        edge_nodes = proj(pts.reshape(-1, 3)).reshape(nE, order - 1, 3)
+        edge_nodes = map_edges(np.arange(1, order) / order)
     else:
         t, w, Q, L, M = edge_moment_matrices(order)
-        pts = A[:, None] + t[None, :, None] * (B - A)[:, None]          # (nE, g, 3)
-        Fp = proj(pts.reshape(-1, 3)).reshape(nE, len(t), 3)
+        Fp = map_edges(t)
         rhs = np.einsum("g,gp,egk->epk", w, Q, Fp)
         rhs -= np.einsum("g,gp,g->p", w, Q, L[:, 0])[None, :, None] * Pv[E[:, 0]][:, None]
         rhs -= np.einsum("g,gp,g->p", w, Q, L[:, order])[None, :, None] * Pv[E[:, 1]][:, None]
@@ -93,21 +126,19 @@ def projected_nodes(V, F, order, project, interpolant="walker"):
     FE = mesh.face_edges
     for j in range(3):                       # 3 local edges: vectorised over faces
         e = FE[:, j]
-        fwd = E[e, 0] == Ff[:, (j + 1) % 3]  # local edge j runs from corner j+1 to j+2
+        fw = E[e, 0] == Ff[:, (j + 1) % 3]   # local edge j runs from corner j+1 to j+2
         ids = nV + e[:, None] * (order - 1) + np.arange(order - 1)[None]
-        ids = np.where(fwd[:, None], ids, ids[:, ::-1])
+        ids = np.where(fw[:, None], ids, ids[:, ::-1])
         elements[:, slots[j]] = ids
     if order == 3:
         c0 = nV + nE * (order - 1)
         elements[:, 9] = c0 + np.arange(nF)
-        X1 = Vf[Ff]                                                    # flat triangles
         if interpolant == "nodal":
-            cen = proj(X1.mean(axis=1))
+            cen = fmap(np.arange(nF), np.full((nF, 3), 1.0 / 3.0))
         else:
             xi, wq = triangle_quadrature(10)
             lam = np.column_stack([1 - xi.sum(1), xi])
-            flat_pts = np.einsum("qc,fck->fqk", lam, X1)
-            Fp = proj(flat_pts.reshape(-1, 3)).reshape(nF, len(wq), 3)
+            Fp = fmap(np.repeat(np.arange(nF), len(wq)), np.tile(lam, (nF, 1))).reshape(nF, len(wq), 3)
             N = lagrange_basis(3).values(xi)                           # (q, 10)
             intN = wq @ N                                              # ∫ N_a dξ
             known = np.concatenate([Pv, edge_nodes.reshape(-1, 3)])[elements[:, :9]]   # (nF, 9, 3)
@@ -115,4 +146,3 @@ def projected_nodes(V, F, order, project, interpolant="walker"):
             cen = (intF - np.einsum("a,fak->fk", intN[:9], known)) / intN[9]
         nodes.append(cen)
     return np.concatenate(nodes), elements
-

@@ -322,6 +322,18 @@ class LagrangeSurface:
         return cls(nodes, elements)
 
     @classmethod
+    def from_parametrization(cls, V, F, order, element_map, interpolant="walker"):
+        """Like :meth:`from_projection`, for an element-wise map onto Γ.
+
+        ``element_map(faces (n,), bary (n, 3)) -> (n, 3)`` maps the point with
+        barycentric coordinates ``bary`` of flat triangle ``faces`` onto Γ (the
+        map F_T of Walker §3.1; it must agree on shared edges), e.g. a chart
+        composed with a curved-boundary ("Lenoir") map of the planar domain."""
+        from .interpolation import mapped_nodes
+        nodes, elements = mapped_nodes(TriangleMesh(V, F), order, element_map, interpolant)
+        return cls(nodes, elements)
+
+    @classmethod
     def from_meshio(cls, mesh):
         """Curved surface from a ``meshio.Mesh`` (or a path meshio can read, e.g. a gmsh ``.msh``).
 
