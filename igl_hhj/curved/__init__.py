@@ -10,8 +10,9 @@ matrices), :mod:`.shape_operator`, :mod:`.field` (:class:`CurvedField`),
 (flat display meshes for the viewer).
 """
 from .field import CurvedField
+from .heine import LagrangeSpace, heine_weingarten
 from .hhj import CurvedHHJ
 from .shape_operator import shape_operator
 from .surface import LagrangeSurface
 
-__all__ = ["LagrangeSurface", "CurvedHHJ", "CurvedField", "shape_operator"]
+__all__ = ["LagrangeSurface", "CurvedHHJ", "CurvedField", "LagrangeSpace", "shape_operator", "heine_weingarten"]
