@@ -304,3 +304,22 @@ def test_display_mesh_is_a_closed_manifold_with_values():
     assert np.abs(s.value(DV)).max() < 0.05
     with pytest.raises(ValueError, match="subdivisions"):
         display_mesh(surf, fld, subdivisions=0)
+
+
+def test_curved_demo_headless(tmp_path):
+    """demos/curved.py renders the three orders and prints errors falling with m."""
+    import subprocess
+    import sys
+    from pathlib import Path
+    from conftest import png_stats, require_egl
+    require_egl()
+    root = Path(__file__).resolve().parents[1]
+    png = tmp_path / "curved.png"
+    res = subprocess.run([sys.executable, "demos/curved.py", "--screenshot", str(png), "--size", "360", "160",
+                          "--subdivisions", "1"], cwd=root, capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0, res.stderr[-3000:]
+    st = png_stats(png)
+    assert (st["width"], st["height"]) == (360, 160) and st["std"] > 0.03 and st["foreground"] > 0.1
+    rows = [line.split("|") for line in res.stdout.splitlines() if line.startswith("| m = ")]
+    err = [float(r[3]) for r in rows]
+    assert len(err) == 3 and err[0] > 3 * err[1] > 9 * err[2], res.stdout
