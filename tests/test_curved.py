@@ -229,6 +229,17 @@ def test_from_projection_and_shape_operator_errors():
         shape_operator(surf, boundary_normals=N)
 
 
+def test_boundary_data_needed_only_on_the_boundary():
+    s, seq = sequence("saddle", 1)
+    V, F = seq[0]
+    surf = LagrangeSurface.from_projection(V, F, 2, s.project)
+    N = s.normal(surf.nodes)
+    full = shape_operator(surf, boundary_normals=N)
+    N[~surf.boundary_nodes] = np.nan
+    part = shape_operator(surf, boundary_normals=N)
+    assert np.allclose(full.coefficients, part.coefficients, rtol=0, atol=1e-12 * np.abs(full.coefficients).max())
+
+
 def test_flat_square_has_zero_shape_operator():
     V, F = _square(4, 0.2)
     surf = LagrangeSurface.from_projection(V, F, 3, lambda X: X)

@@ -99,9 +99,10 @@ def shape_operator(surface, *, boundary_normals=None, boundary_shape_operator=No
         if (np.linalg.norm(Nd[need], axis=1) < 1e-12).any():
             raise ValueError("boundary_normals has a zero vector at a boundary node")
         Nd = np.where(np.isfinite(Nd), Nd, 0.0)
-        dots = np.einsum("nk,nk->n", Nd[mesh.F[:, 0]], mesh.face_normals)
         f_b, _ = surface.boundary_face_and_local(clamped_e)
-        if (dots[f_b] <= 0).any():
+        ends = mesh.edges[clamped_e]
+        dots = np.einsum("nck,nk->nc", Nd[ends], mesh.face_normals[f_b])
+        if (dots <= 0).any():
             raise ValueError("boundary_normals point away from the surface normals on a boundary face: "
                              "they must agree with the elements' orientation")
     if bnd.size:
