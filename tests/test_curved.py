@@ -334,3 +334,15 @@ def test_curved_demo_headless(tmp_path):
     rows = [line.split("|") for line in res.stdout.splitlines() if line.startswith("| m = ")]
     err = [float(r[3]) for r in rows]
     assert len(err) == 3 and err[0] > 3 * err[1] > 9 * err[2], res.stdout
+
+
+@pytest.mark.parametrize("order,boundary", [(2, "none"), (3, "simply_supported")])
+def test_static_condensation_gives_the_same_solution(order, boundary):
+    name = "torus" if boundary == "none" else "saddle"
+    s, seq = sequence(name, 1)
+    V, F = seq[0]
+    surf = LagrangeSurface.from_projection(V, F, order, s.project)
+    kw = {"boundary_shape_operator": s.shape_operator(surf.nodes)} if boundary != "none" else {}
+    a = shape_operator(surf, condense=False, **kw).coefficients
+    b = shape_operator(surf, condense=True, **kw).coefficients
+    assert np.abs(a - b).max() <= 1e-10 * np.abs(a).max()

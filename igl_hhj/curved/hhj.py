@@ -36,6 +36,8 @@ from functools import cached_property
 import numpy as np
 import scipy.sparse as sp
 
+from ..hhj import solve_spd
+
 from .reference import (CORNERS, EDGE_OUTWARD, EDGE_TANGENTS, lagrange_basis, lagrange_nodes,
                         line_quadrature, triangle_quadrature)
 from .surface import ElementGeometry, LagrangeSurface
@@ -136,6 +138,13 @@ class CurvedHHJ:
         # basis scaling: functions of edge j carry the squared chord length l_j², so that
         # each DOF is ≈ the nn-trace itself (exactly it for m = 1: the flat basis of hhj.py)
         self.scale = np.repeat(mesh.edge_lengths ** 2, nr, axis=1)       # (#F, nb)
+        edge_local = np.zeros((3, nr), dtype=bool)
+        for j in range(3):
+            for (i, _slot) in on[j]:
+                edge_local[j, i] = True
+        self.local_edge = np.flatnonzero(edge_local.ravel())             # local functions with edge DOFs
+        self.local_interior = np.flatnonzero(~edge_local.ravel())        # face-interior DOFs
+        self.n_edge_dofs = base
 
     def reference_basis(self, xi):
         """(q, nb, 2, 2) reference tensors Σ̂_k(ξ) = L_i(ξ) S_j."""
@@ -200,6 +209,8 @@ class CurvedHHJ:
             edge_nn.append(np.einsum("d,gbde,e->gb", EDGE_OUTWARD[j], Se, EDGE_OUTWARD[j]))
         nb, nn_ = self.nb, surf.elements.shape[1]
         rowsA, colsA, valsA, rowsB, colsB, valsB = [], [], [], [], [], []
+        ie, ii = self.local_edge, self.local_interior
+        cond_vals, Aii_inv, Aie = [], [], []
         for f0 in range(0, surf.n_faces, CHUNK):                      # batches of faces, not a per-element loop
             fs = slice(f0, min(f0 + CHUNK, surf.n_faces))
             X = surf.nodes[surf.elements[fs]]
@@ -235,11 +246,70 @@ class CurvedHHJ:
             rowsB.append(np.broadcast_to(D[:, :, None], Bloc.shape).ravel())
             colsB.append(np.broadcast_to(Ni[:, None, :], Bloc.shape).ravel())
             valsB.append(Bloc.ravel())
+            if ii.size:                                               # static condensation, per face
+                Ai = np.linalg.inv(Aloc[:, ii][:, :, ii])
+                Aei = Aloc[:, ii][:, :, ie]
+                Aii_inv.append(Ai)
+                Aie.append(Aei)
+                cond_vals.append(Aloc[:, ie][:, :, ie] - Aei.swapaxes(1, 2) @ Ai @ Aei)
+        if ii.size:
+            self._Aii_inv = np.concatenate(Aii_inv)
+            self._Aie = np.concatenate(Aie)
+            De = self.dofs[:, ie]
+            Sc = np.concatenate(cond_vals)
+            self._A_condensed = sp.coo_matrix(
+                (Sc.ravel(), (np.broadcast_to(De[:, :, None], Sc.shape).ravel(),
+                              np.broadcast_to(De[:, None, :], Sc.shape).ravel())),
+                shape=(self.n_edge_dofs, self.n_edge_dofs)).tocsr()
         A = sp.coo_matrix((np.concatenate(valsA), (np.concatenate(rowsA), np.concatenate(colsA))),
                           shape=(self.n_dofs, self.n_dofs)).tocsr()
         B = sp.coo_matrix((np.concatenate(valsB), (np.concatenate(rowsB), np.concatenate(colsB))),
                           shape=(self.n_dofs, surf.n_nodes)).tocsr()
         return A, B
+
+    def solve(self, rhs, fixed=None, fixed_values=None, solver="direct", condense=True):
+        """Solve ``A s = rhs`` (rhs (n_dofs, k)) with the DOFs ``fixed`` (bool, edge DOFs only)
+        prescribed to ``fixed_values``.
+
+        ``condense=True`` eliminates the face-interior DOFs first (they couple only
+        within their face): the Schur complement on the edge DOFs,
+        ``S = A_ee - A_ei A_ii⁻¹ A_ie``, assembled from 3(r+1)-square face blocks, is
+        solved and the interior DOFs recovered face by face — the same solution,
+        with a third (m = 3) to a half (m = 2) of the unknowns."""
+        A, _ = self.matrices
+        k = rhs.shape[1]
+        s = np.zeros((self.n_dofs, k))
+        if fixed is None:
+            fixed = np.zeros(self.n_dofs, dtype=bool)
+        if fixed.any():
+            s[fixed] = fixed_values[fixed]
+        if not condense or self.local_interior.size == 0:
+            free = ~fixed
+            r = rhs[free] - (A[free][:, fixed] @ s[fixed] if fixed.any() else 0.0)
+            Af = A[free][:, free] if fixed.any() else A
+            s[free] = solve_spd(Af, r, method=solver)
+            return s
+        ne = self.n_edge_dofs
+        if fixed[ne:].any():
+            raise ValueError("only edge DOFs can be fixed")
+        Di = self.dofs[:, self.local_interior]                       # (#F, ni)
+        De = self.dofs[:, self.local_edge]
+        ri = rhs[Di]                                                 # (#F, ni, k)
+        y = self._Aii_inv @ ri                                       # A_ii⁻¹ r_i
+        rc = rhs[:ne].copy()
+        np.add.at(rc, De.ravel(), -(self._Aie.swapaxes(1, 2) @ y).reshape(-1, k))
+        S = self._A_condensed
+        fe = fixed[:ne]
+        free = ~fe
+        if fe.any():
+            r = rc[free] - S[free][:, fe] @ s[:ne][fe]
+            se = s[:ne].copy()
+            se[free] = solve_spd(S[free][:, free], r, method=solver)
+        else:
+            se = solve_spd(S, rc, method=solver)
+        s[:ne] = se
+        s[Di.ravel()] = (y - self._Aii_inv @ (self._Aie @ se[De])).reshape(-1, k)
+        return s
 
     def boundary_edge_terms(self, edges, normal_data=None):
         """Loads of clamped boundary edges (eq. 5.19's Σ_c term, plus the plain part).

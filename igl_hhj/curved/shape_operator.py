@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..hhj import solve_spd
 from .field import CurvedField
 from .hhj import CurvedHHJ
 from .surface import LagrangeSurface
@@ -28,7 +27,7 @@ def _per_node(surface, values, name, tail):
 
 
 def shape_operator(surface, *, boundary_normals=None, boundary_shape_operator=None,
-                   simply_supported=None, degree=None, solver="direct"):
+                   simply_supported=None, degree=None, solver="direct", condense=True):
     """HHJ shape operator S_h of a curved surface, as a :class:`CurvedField`.
 
     Parameters
@@ -52,6 +51,9 @@ def shape_operator(surface, *, boundary_normals=None, boundary_shape_operator=No
         Passed to :func:`igl_hhj.hhj.solve_spd` (Jacobi-PCG for "cg"; A^m's
         condition number grows ~10²–10³× from m = 1 to m = 2, 3, so the
         default is the sparse direct solve).
+    condense : bool
+        Eliminate the face-interior HHJ DOFs before the solve (static
+        condensation, :meth:`CurvedHHJ.solve`; same solution, fewer unknowns).
 
     Returns
     -------
@@ -120,13 +122,7 @@ def shape_operator(surface, *, boundary_normals=None, boundary_shape_operator=No
         ids, vals = _simply_supported_values(space, ss_e, Sd)
         fixed[ids] = True
         s[ids] = vals
-    free = ~fixed
-    if fixed.any():
-        A_ff = A[free][:, free]
-        r = rhs[free] - A[free][:, fixed] @ s[fixed]
-    else:
-        A_ff, r = A, rhs
-    s[free] = solve_spd(A_ff, r, method=solver)
+    s = space.solve(rhs, fixed, s, solver=solver, condense=condense)
     return CurvedField(space, s, kind="hhj")
 
 
