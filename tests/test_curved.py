@@ -248,7 +248,7 @@ def test_flat_square_has_zero_shape_operator():
     assert np.abs(fld(f, b)).max() < 1e-10
 
 
-def test_meshio_round_trip():
+def test_meshio_round_trip(tmp_path):
     meshio = pytest.importorskip("meshio")
     s, seq = _sphere_levels(1)
     V, F = seq[0]
@@ -257,6 +257,11 @@ def test_meshio_round_trip():
     assert isinstance(m, meshio.Mesh)
     back = LagrangeSurface.from_meshio(m)
     assert back.order == 3 and np.array_equal(back.elements, surf.elements)
+    path = tmp_path / "sphere3.msh"          # gmsh's own triangle10 order, through a file
+    meshio.write(str(path), m, file_format="gmsh22", binary=False)
+    again = LagrangeSurface.from_meshio(str(path))
+    assert np.array_equal(again.elements, surf.elements) and np.allclose(again.nodes, surf.nodes)
+    assert abs(again.area() - surf.area()) < 1e-12
     with pytest.raises(TypeError):
         LagrangeSurface.from_meshio(42)
 
