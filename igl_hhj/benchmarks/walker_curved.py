@@ -221,7 +221,7 @@ def run_curved(surfaces, orders=(2, 3), levels=3, cond_levels=2, progress=True, 
                 e = shape_operator_errors(fld, surface)
                 e["seconds"] = time.perf_counter() - t0
                 e["dofs"] = fld.space.n_dofs
-                e["cond_A"] = e["cond_DA"] = float("nan")
+                e["cond_A"] = e["cond_DA"] = e["cond_S"] = e["cond_DS"] = float("nan")
                 if cond_levels is not None and k < cond_levels:
                     A, _ = fld.space.matrices
                     if BOUNDARY[name] == "simply_supported":
@@ -230,6 +230,10 @@ def run_curved(surfaces, orders=(2, 3), levels=3, cond_levels=2, progress=True, 
                         free[fld.space.edge_dofs[b].ravel()] = False
                         A = A[free][:, free]
                     e["cond_A"], e["cond_DA"] = condition_numbers(A)
+                    Sc = fld.space._A_condensed
+                    if BOUNDARY[name] == "simply_supported":
+                        Sc = Sc[free[:fld.space.n_edge_dofs]][:, free[:fld.space.n_edge_dofs]]
+                    e["cond_S"], e["cond_DS"] = condition_numbers(Sc)
                 rows.append(e)
                 if bar is not None:
                     bar.set_postfix_str(f"{name} m={m} k={k} #F={len(F)}")
@@ -264,14 +268,16 @@ def format_curved_table(name, m, rows, m1_cond=None):
             lines.append(f"| paper {k} | | | " + " | ".join(f"{_fmt(v)}{_fmt_eoc(q)}" for v, q in zip(pe, pr)) + " | |")
     lines.append("")
     if any(np.isfinite(r["cond_A"]) for r in rows):
-        lines += ["| k | #DOF | κ(A^m) | κ(D⁻¹A^m) |" + (" κ(A^m)/κ(A^1) |" if m1_cond else ""),
-                  "|---|---|---|---|" + ("---|" if m1_cond else "")]
+        lines += ["| k | #DOF | κ(A^m) | κ(D⁻¹A^m) | κ(S^m) condensed | κ(D⁻¹S^m) |"
+                  + (" κ(A^m)/κ(A^1) |" if m1_cond else ""),
+                  "|---|---|---|---|---|---|" + ("---|" if m1_cond else "")]
         for k, r in enumerate(rows):
             if not np.isfinite(r["cond_A"]):
                 continue
             ratio = ""
             if m1_cond and k < len(m1_cond) and np.isfinite(m1_cond[k]):
                 ratio = f" {r['cond_A'] / m1_cond[k]:.0f} |"
-            lines.append(f"| {k} | {r['dofs']} | {_fmt(r['cond_A'])} | {_fmt(r['cond_DA'])} |" + ratio)
+            lines.append(f"| {k} | {r['dofs']} | {_fmt(r['cond_A'])} | {_fmt(r['cond_DA'])} | "
+                         f"{_fmt(r.get('cond_S'))} | {_fmt(r.get('cond_DS'))} |" + ratio)
         lines.append("")
     return "\n".join(lines)

@@ -27,7 +27,7 @@ def _per_node(surface, values, name, tail):
 
 
 def shape_operator(surface, *, boundary_normals=None, boundary_shape_operator=None,
-                   simply_supported=None, degree=None, solver="direct", condense=True):
+                   simply_supported=None, degree=None, solver="auto", condense=True):
     """HHJ shape operator S_h of a curved surface, as a :class:`CurvedField`.
 
     Parameters
@@ -47,10 +47,12 @@ def shape_operator(surface, *, boundary_normals=None, boundary_shape_operator=No
         are simply supported, the others clamped (as the flat API).
     degree : int, optional
         HHJ degree r (default m − 1, Walker's choice m = r + 1).
-    solver : {"direct", "auto", "cg"}
-        Passed to :func:`igl_hhj.hhj.solve_spd` (Jacobi-PCG for "cg"; A^m's
-        condition number grows ~10²–10³× from m = 1 to m = 2, 3, so the
-        default is the sparse direct solve).
+    solver : {"auto", "direct", "cg"}
+        Passed to :func:`igl_hhj.hhj.solve_spd` (Jacobi-PCG for "cg"; "auto":
+        direct up to 50 000 unknowns, PCG above).  A^m's condition number grows
+        with m (measured 5–23× the m = 1 value with this basis), but the
+        condensed matrix (``condense=True``) is as well conditioned as m = 1
+        (κ ≈ 10², measured), so PCG converges quickly.
     condense : bool
         Eliminate the face-interior HHJ DOFs before the solve (static
         condensation, :meth:`CurvedHHJ.solve`; same solution, fewer unknowns).
