@@ -351,3 +351,17 @@ def test_static_condensation_gives_the_same_solution(order, boundary):
     a = shape_operator(surf, condense=False, **kw).coefficients
     b = shape_operator(surf, condense=True, **kw).coefficients
     assert np.abs(a - b).max() <= 1e-10 * np.abs(a).max()
+
+
+def test_walker_tables_orders_cli(tmp_path, capsys):
+    from igl_hhj.benchmarks.walker_curved import PAPER_CURVED
+    from igl_hhj.benchmarks.walker_tables import main
+    main(["--orders", "2", "--surfaces", "saddle", "--curved-levels", "2", "--curved-cond-levels", "1",
+          "--out", str(tmp_path)])
+    text = (tmp_path / "walker_tables_curved.md").read_text(encoding="utf-8")
+    assert "### saddle, m = 2" in text and "| paper 1 |" in text and "κ(S^m) condensed" in text
+    rows = [r for r in text.splitlines() if r.startswith("| 1 | 1792")]
+    eoc_S = float(rows[0].split("|")[5].split("(")[1].rstrip(") "))
+    assert eoc_S > 1.8
+    assert set(PAPER_CURVED) == {"saddle", "dumbbell", "torus", "genus3"}
+    assert all(len(PAPER_CURVED[n][m]) >= 4 for n in PAPER_CURVED for m in (2, 3))
