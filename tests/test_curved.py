@@ -204,6 +204,16 @@ def test_validation_errors():
         LagrangeSurface(Pf, E)
 
 
+def test_int32_float32_inputs():
+    surf = _quad_disk()
+    a = LagrangeSurface(surf.nodes.astype(np.float32), surf.elements.astype(np.int32))
+    assert a.nodes.dtype == np.float64 and a.elements.dtype == np.int64
+    V, F = _square()
+    b = LagrangeSurface.from_projection(V.astype(np.float32), F.astype(np.int32), 3, lambda X: X)
+    assert abs(b.area() - 1.0) < 1e-6
+    assert b.points(np.array([0], dtype=np.int32), np.array([[1, 0, 0]], dtype=np.float32)).shape == (1, 3)
+
+
 def test_from_projection_and_shape_operator_errors():
     V, F = _square()
     with pytest.raises(ValueError, match="order"):
