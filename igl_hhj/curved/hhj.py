@@ -15,10 +15,13 @@ the shared curved edge, the same from both sides.  With the reference basis
 
 (t̂_i^⊥ᵀ S_j t̂_i^⊥ = δ_ij) the trace on edge j is p_j|_E / |J t̂_j|², so the
 nn-continuity (each element with its own conormal) is the continuity of the
-scalar P_r polynomial p_j along edge j.  DOFs: p_j at the r + 1 equispaced
-nodes of edge j (shared by the two faces of the edge; r = 0: the midpoint),
-and p_j at the P_r nodes off edge j (interior to the face).  dim = (r+1)#E +
-3 (dim P_r - r - 1) #F.
+scalar P_r polynomial p_j along edge j.  DOFs: p_j / l_j² (l_j the chord
+length of edge j, so that a DOF is ≈ the nn-value itself, and exactly the flat
+basis of :mod:`igl_hhj.hhj` for m = 1) at the r + 1 equispaced nodes of edge j
+(shared by the two faces of the edge; r = 0: the midpoint), and at the P_r
+nodes off edge j (interior to the face).  dim = (r+1)#E + 3 (dim P_r - r - 1) #F.
+The face-interior DOFs couple only within their face and are condensed out
+before the solve (:meth:`CurvedHHJ.solve`).
 
 Matrices (reference-coordinate forms, w = quadrature weights on T̂):
 
