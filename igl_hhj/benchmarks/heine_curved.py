@@ -10,7 +10,7 @@ C ∈ {K, H}, r ∈ {2, ∞}, with H_h = tr Π_h / 2 and K_h the sum of the 2×2
 principal minors of Π_h, the exact C at the projection of each quadrature
 point.  Run::
 
-    python -m igl_hhj.benchmarks.heine_curved [--levels 4] [--degrees 1 2]
+    python -m igl_hhj.benchmarks.heine_curved [--levels 4] [--degrees 1 2] [--jitter 0.3]
 """
 from __future__ import annotations
 
@@ -98,9 +98,12 @@ def main(argv=None):
     ap.add_argument("--levels", type=int, default=4)
     ap.add_argument("--degrees", type=int, nargs="+", default=[1, 2], choices=(1, 2, 3))
     ap.add_argument("--surfaces", nargs="+", default=["5.1a", "5.1b", "5.1c", "5.1d"])
+    ap.add_argument("--jitter", type=float, default=0.3,
+                    help="re-perturbation of every level (0: plain uniform refinement)")
+    ap.add_argument("--seed", type=int, default=100)
     a = ap.parse_args(argv)
     t0 = time.perf_counter()
-    res = run(a.surfaces, a.degrees, a.levels)
+    res = run(a.surfaces, a.degrees, a.levels, seed=a.seed, jitter=a.jitter)
     for (lab, g), rows in res.items():
         print(format_table(lab, g, rows))
     print(f"total {time.perf_counter() - t0:.1f} s")
