@@ -12,6 +12,7 @@ shows and which numbers it prints.  Some need the ``demos`` extra
 ``boundary_data``      open surfaces without boundary data, clamped, simply supported
 ``biharmonic``         mixed P1 biharmonic solution and its error, convergence rates
 ``regge``              Regge Gauss curvature K_h beside HHJ's and the exact K, Gauss–Bonnet
+``curved``             HHJ on curved triangles of order m = 1, 2, 3 (Walker's torus / genus 3)
 =====================  ==========================================================
 """
 from __future__ import annotations
@@ -19,7 +20,8 @@ from __future__ import annotations
 import importlib
 from typing import Sequence
 
-DEMOS = ("quickstart", "compare_curvature", "refinement", "boundary_data", "biharmonic", "regge")
+DEMOS = ("quickstart", "compare_curvature", "refinement", "boundary_data", "biharmonic", "regge",
+         "curved")
 """Names accepted by :func:`run` and ``igl-hhj demo NAME``."""
 
 
