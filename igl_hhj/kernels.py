@@ -29,7 +29,7 @@ except ImportError as exc:  # pragma: no cover - exercised only on a broken inst
 __all__ = [
     "topology", "hhj_system", "jump_apply", "block_pcg", "shape_operator_faces",
     "face_tensors", "lumped_vertex_recovery", "principal_2x2", "max_threads",
-    "set_num_threads", "ell_indptr",
+    "set_num_threads", "ell_indptr", "edge_morton_order",
 ]
 
 
@@ -42,6 +42,10 @@ def _f64(a, name, shape_tail=None):
 
 def _i64(a):
     return np.ascontiguousarray(a, dtype=np.int64)
+
+
+def _i32(a):
+    return np.ascontiguousarray(a, dtype=np.int32)
 
 
 def max_threads():
@@ -76,7 +80,14 @@ def topology(F, n_vertices):
     return _core.topology(F, int(n_vertices))
 
 
-def hhj_system(mesh, fixed=None, schwarz=True):
+def edge_morton_order(mesh):
+    """(#E,) int64 permutation listing the edges by the Morton (Z-order) code of their
+    midpoints: a cache-friendly numbering for the solver (the lexicographic edge order
+    scatters neighbouring edges across memory)."""
+    return _core.edge_morton_order(mesh.V, _i64(mesh.edges))
+
+
+def hhj_system(mesh, fixed=None, schwarz=True, topology=None):
     """Assembled HHJ matrix A and its face-Schwarz preconditioner M, fixed-width rows.
 
     Reference: :func:`igl_hhj.hhj.mass_matrix` and
@@ -89,6 +100,9 @@ def hhj_system(mesh, fixed=None, schwarz=True):
         Fixed DOFs: M gets zero rows/columns there (A is returned unmasked).
     schwarz : bool
         Also build M.
+    topology : (face_edges, edge_faces, edge_local_index), optional
+        A renumbering of the mesh's edge maps (e.g. by :func:`edge_morton_order`);
+        rows, columns and ``fixed`` are then in that numbering.
 
     Returns
     -------
@@ -99,8 +113,14 @@ def hhj_system(mesh, fixed=None, schwarz=True):
     n_jacobi : int, faces whose block was numerically singular and got Jacobi instead
     """
     fx = None if fixed is None else np.ascontiguousarray(fixed, dtype=np.uint8)
-    return _core.hhj_system(mesh.V, mesh.F, _i64(mesh.face_edges), _i64(mesh.edge_faces),
-                            _i64(mesh.edge_local_index), fx, bool(schwarz))
+    FE, EF, ELI = topology if topology is not None else \
+        (mesh.face_edges, mesh.edge_faces, mesh.edge_local_index)
+    FE, EF, ELI = _i64(FE), _i64(EF), _i64(ELI)
+    nE = mesh.n_edges
+    if FE.shape != (mesh.n_faces, 3) or EF.shape != (nE, 2) or ELI.shape != (nE, 2) \
+            or (fx is not None and fx.shape != (nE,)):
+        raise ValueError("hhj_system: topology arrays do not match the mesh")
+    return _core.hhj_system(mesh.V, mesh.F, FE, EF, ELI, fx, bool(schwarz))
 
 
 def jump_apply(mesh, W):
@@ -120,6 +140,7 @@ def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,
               probe_iter=0, max_predicted=np.inf):
     """Fused block PCG on all columns of ``R`` (n, k ≤ 16) for a CSR matrix.
 
+    Column indices travel as int32 (memory bandwidth: the sweeps are memory-bound).
     Reference: :func:`igl_hhj.hhj._block_pcg`.  Preconditioner: ``M`` =
     ``(indptr, indices, data)`` of a CSR matrix, else Jacobi with ``dinv``.
 
@@ -136,14 +157,16 @@ def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,
     if R.ndim != 2:
         raise ValueError(f"R must be (n, k), got {R.shape}")
     n = R.shape[0]
-    indptr, indices, data = _i64(indptr), _i64(indices), _f64(data, "data")
+    if n >= 2 ** 31:
+        raise ValueError(f"block_pcg handles fewer than 2**31 unknowns, got {n}")
+    indptr, indices, data = _i64(indptr), _i32(indices), _f64(data, "data")
     if indptr.shape != (n + 1,) or indices.shape != data.shape or indptr[-1] > len(indices):
         raise ValueError("inconsistent CSR arrays for block_pcg")
     if len(indices) and (indices.min() < 0 or indices.max() >= n):
         raise ValueError("CSR column index out of range in block_pcg")
     Mp = Mi = Mx = None
     if M is not None:
-        Mp, Mi, Mx = _i64(M[0]), _i64(M[1]), _f64(M[2], "M")
+        Mp, Mi, Mx = _i64(M[0]), _i32(M[1]), _f64(M[2], "M")
         if Mp.shape != (n + 1,) or Mi.shape != Mx.shape or (len(Mi) and (Mi.min() < 0 or Mi.max() >= n)):
             raise ValueError("inconsistent preconditioner CSR arrays for block_pcg")
     elif dinv is not None:

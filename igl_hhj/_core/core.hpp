@@ -91,6 +91,7 @@ struct Topology {
     i64 n_edges = 0;
 };
 void topology(const i64* F, i64 nF, i64 nV, Topology& out);
+void edge_morton_order(const double* V, i64 nV, const i64* E, i64 nE, i64* perm);
 
 // hhj_kernels.cpp
 void local_mass(const double* V, const i64* F, i64 nF, double* Aloc);
@@ -115,8 +116,8 @@ struct PCGResult {
     int status = 0;              // 0 converged, 1 iteration cap, 2 stopped early (slow)
     std::vector<double> relres;  // per column
 };
-PCGResult block_pcg(i64 n, int k, const i64* Ap, const i64* Ai, const double* Ax,
-                    const i64* Mp, const i64* Mi, const double* Mx, const double* dinv,
+PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const double* Ax,
+                    const i64* Mp, const std::int32_t* Mi, const double* Mx, const double* dinv,
                     const double* R, double* X, double rtol, i64 maxiter,
                     i64 probe_iter, double max_predicted, int nt);
 

@@ -2,6 +2,7 @@
 // smaller vertex, then by the larger): unique edges, face->edge, edge->face,
 // incidence counts and half-edge signs, in the conventions of igl_hhj/mesh.py.
 #include <algorithm>
+#include <utility>
 
 #include "core.hpp"
 
@@ -67,6 +68,46 @@ void topology(const i64* F, i64 nF, i64 nV, Topology& T) {
         T.edge_faces[2 * e + col] = h / 3;
         T.local_index[2 * e + col] = h % 3;
     }
+}
+
+}  // namespace hhj
+
+namespace hhj {
+
+namespace {
+inline std::uint64_t spread3(std::uint64_t x) {  // 21 bits -> every third bit
+    x &= 0x1fffffULL;
+    x = (x | x << 32) & 0x1f00000000ffffULL;
+    x = (x | x << 16) & 0x1f0000ff0000ffULL;
+    x = (x | x << 8) & 0x100f00f00f00f00fULL;
+    x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+    x = (x | x << 2) & 0x1249249249249249ULL;
+    return x;
+}
+}  // namespace
+
+// edge_morton_order: perm (#E,) listing the edges by the Morton (Z-order) code of their
+// midpoints (ties by index): a memory-local numbering for the solver's sparse sweeps.
+void edge_morton_order(const double* V, i64 nV, const i64* E, i64 nE, i64* perm) {
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (i64 v = 0; v < nV; ++v)
+        for (int a = 0; a < 3; ++a) { lo[a] = std::min(lo[a], V[3 * v + a]); hi[a] = std::max(hi[a], V[3 * v + a]); }
+    double scale = 0.0;
+    for (int a = 0; a < 3; ++a) scale = std::max(scale, hi[a] - lo[a]);
+    scale = scale > 0 ? 2097151.0 / scale : 0.0;
+    std::vector<std::pair<std::uint64_t, i64>> key(nE);
+    for (i64 e = 0; e < nE; ++e) {
+        std::uint64_t code = 0;
+        for (int a = 0; a < 3; ++a) {
+            const double mid = 0.5 * (V[3 * E[2 * e] + a] + V[3 * E[2 * e + 1] + a]);
+            double q = (mid - lo[a]) * scale;
+            q = q < 0 ? 0 : (q > 2097151.0 ? 2097151.0 : q);
+            code |= spread3((std::uint64_t)q) << a;
+        }
+        key[e] = {code, e};
+    }
+    std::sort(key.begin(), key.end());
+    for (i64 e = 0; e < nE; ++e) perm[e] = key[e].second;
 }
 
 }  // namespace hhj

@@ -22,9 +22,12 @@ struct Partials {
     }
 };
 
-// y = Op x for CSR (p, i, v) or, without it, y = dinv .* x;  partial sums of x.y per chunk
-void apply_and_dot(i64 n, int k, const i64* p, const i64* idx, const double* v, const double* dinv,
-                   const double* x, double* y, const double* dotwith, Partials& P, int nt) {
+// y = Op x for CSR (p, i, v) or, without it, y = dinv .* x;  partial sums of d.y per chunk.
+// K = number of columns known at compile time (0: runtime k), local accumulators.
+template <int K>
+void apply_and_dot_k(i64 n, int kr, const i64* p, const std::int32_t* idx, const double* v, const double* dinv,
+                     const double* x, double* y, const double* d, Partials& P, int nt) {
+    const int k = K ? K : kr;
 #ifdef IGL_HHJ_OPENMP
 #pragma omp parallel for schedule(static) num_threads(nt)
 #endif
@@ -32,21 +35,68 @@ void apply_and_dot(i64 n, int k, const i64* p, const i64* idx, const double* v, 
         const i64 r0 = c * CHUNK, r1 = std::min(n, r0 + CHUNK);
         double acc[16] = {0};
         for (i64 r = r0; r < r1; ++r) {
-            double* yr = y + r * k;
+            double yr[16];
             if (p) {
                 for (int j = 0; j < k; ++j) yr[j] = 0.0;
-                for (i64 q = p[r]; q < p[r + 1]; ++q) {
+                const i64 q1 = p[r + 1];
+                for (i64 q = p[r]; q < q1; ++q) {
                     const double a = v[q];
-                    const double* xc = x + idx[q] * k;
+                    const double* xc = x + (i64)idx[q] * k;
                     for (int j = 0; j < k; ++j) yr[j] += a * xc[j];
                 }
             } else {
-                for (int j = 0; j < k; ++j) yr[j] = dinv[r] * x[r * k + j];
+                const double di = dinv[r];
+                for (int j = 0; j < k; ++j) yr[j] = di * x[r * k + j];
             }
-            const double* d = dotwith + r * k;
-            for (int j = 0; j < k; ++j) acc[j] += d[j] * yr[j];
+            for (int j = 0; j < k; ++j) {
+                y[r * k + j] = yr[j];
+                acc[j] += d[r * k + j] * yr[j];
+            }
         }
         for (int j = 0; j < k; ++j) P.buf[(size_t)c * k + j] = acc[j];
+    }
+}
+
+void apply_and_dot(i64 n, int k, const i64* p, const std::int32_t* idx, const double* v, const double* dinv,
+                   const double* x, double* y, const double* d, Partials& P, int nt) {
+    switch (k) {
+        case 1: apply_and_dot_k<1>(n, k, p, idx, v, dinv, x, y, d, P, nt); break;
+        case 3: apply_and_dot_k<3>(n, k, p, idx, v, dinv, x, y, d, P, nt); break;
+        default: apply_and_dot_k<0>(n, k, p, idx, v, dinv, x, y, d, P, nt);
+    }
+}
+
+// X += alpha p; r -= alpha q; partial sums of r.r per chunk
+template <int K>
+void update_k(i64 n, int kr, const double* alpha_in, double* X, double* r, const double* p,
+              const double* q, Partials& P, int nt) {
+    const int k = K ? K : kr;
+    double alpha[16];
+    for (int j = 0; j < k; ++j) alpha[j] = alpha_in[j];
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+    for (i64 c = 0; c < P.nch; ++c) {
+        const i64 r0 = c * CHUNK, r1 = std::min(n, r0 + CHUNK);
+        double acc[16] = {0};
+        for (i64 i = r0; i < r1; ++i)
+            for (int j = 0; j < k; ++j) {
+                const size_t s = (size_t)i * k + j;
+                X[s] += alpha[j] * p[s];
+                const double rs = r[s] - alpha[j] * q[s];
+                r[s] = rs;
+                acc[j] += rs * rs;
+            }
+        for (int j = 0; j < k; ++j) P.buf[(size_t)c * k + j] = acc[j];
+    }
+}
+
+void update(i64 n, int k, const double* alpha, double* X, double* r, const double* p, const double* q,
+            Partials& P, int nt) {
+    switch (k) {
+        case 1: update_k<1>(n, k, alpha, X, r, p, q, P, nt); break;
+        case 3: update_k<3>(n, k, alpha, X, r, p, q, P, nt); break;
+        default: update_k<0>(n, k, alpha, X, r, p, q, P, nt);
     }
 }
 }  // namespace
@@ -56,8 +106,8 @@ void apply_and_dot(i64 n, int k, const i64* p, const i64* idx, const double* v, 
 // Column j stops when |r_j| <= rtol |R_j|.  Every probe_iter iterations (0: never) the
 // iterations still needed are extrapolated from the mean rate so far; above
 // max_predicted the solve stops early (status 2) so the caller can switch solvers.
-PCGResult block_pcg(i64 n, int k, const i64* Ap, const i64* Ai, const double* Ax,
-                    const i64* Mp, const i64* Mi, const double* Mx, const double* dinv,
+PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const double* Ax,
+                    const i64* Mp, const std::int32_t* Mi, const double* Mx, const double* dinv,
                     const double* R, double* X, double rtol, i64 maxiter,
                     i64 probe_iter, double max_predicted, int nt) {
     if (k > 16) throw std::invalid_argument("block_pcg: at most 16 right-hand sides per call");
@@ -99,21 +149,7 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const i64* Ai, const double* Ax
         apply_and_dot(n, k, Ap, Ai, Ax, nullptr, p.data(), q.data(), p.data(), P, nt);
         P.reduce(pq);
         for (int j = 0; j < k; ++j) alpha[j] = active[j] ? rz[j] / pq[j] : 0.0;
-#ifdef IGL_HHJ_OPENMP
-#pragma omp parallel for schedule(static) num_threads(nt)
-#endif
-        for (i64 c = 0; c < P.nch; ++c) {
-            const i64 r0 = c * CHUNK, r1 = std::min(n, r0 + CHUNK);
-            double acc[16] = {0};
-            for (i64 i = r0; i < r1; ++i)
-                for (int j = 0; j < k; ++j) {
-                    const size_t s = (size_t)i * k + j;
-                    X[s] += alpha[j] * p[s];
-                    r[s] -= alpha[j] * q[s];
-                    acc[j] += r[s] * r[s];
-                }
-            for (int j = 0; j < k; ++j) P.buf[(size_t)c * k + j] = acc[j];
-        }
+        update(n, k, alpha.data(), X, r.data(), p.data(), q.data(), P, nt);
         P.reduce(rr);
         res.iterations = it;
         any = false;
@@ -144,10 +180,14 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const i64* Ai, const double* Ax
 #endif
         for (i64 c = 0; c < P.nch; ++c) {
             const i64 r0 = c * CHUNK, r1 = std::min(n, r0 + CHUNK);
+            double b[16];
+            for (int j = 0; j < k; ++j) b[j] = beta[j];
+            double* pp = p.data();
+            const double* zz = z.data();
             for (i64 i = r0; i < r1; ++i)
                 for (int j = 0; j < k; ++j) {
                     const size_t s = (size_t)i * k + j;
-                    p[s] = z[s] + beta[j] * p[s];
+                    pp[s] = zz[s] + b[j] * pp[s];
                 }
         }
     }
