@@ -62,12 +62,23 @@ def _pcg_iter_seconds(n, k):
     return 2.0e-8 * n * (1 + k)
 
 
-def cholesky_solve(A, R):
-    """Solve ``A X = R`` for SPD sparse A by one sparse Cholesky factorisation.
+def _splu_solve(A, R):
+    import scipy.sparse.linalg as spla
+    try:
+        return spla.splu(sp.csc_matrix(A)).solve(R)
+    except RuntimeError as exc:
+        raise SolverError(f"sparse LU failed: {exc}") from None
 
-    CHOLMOD via cholespy; SuperLU (``scipy.sparse.linalg.splu``) if cholespy is
-    not available.  ``R`` (n,) or (n, k).  Raises :class:`SolverError` when the
-    factorisation fails or the solution is not finite."""
+
+def cholesky_solve(A, R, *, prefer_lu=False):
+    """Solve ``A X = R`` for SPD sparse A by one sparse factorisation.
+
+    Sparse Cholesky (CHOLMOD via cholespy); SuperLU (``scipy.sparse.linalg.splu``,
+    LU with partial pivoting) when cholespy is not available, when
+    ``prefer_lu`` is set (matrices known to be numerically semi-definite, e.g.
+    with faces of relative area ~1e-9) or when CHOLMOD finds the matrix not
+    numerically positive definite.  ``R`` (n,) or (n, k).  Raises
+    :class:`SolverError` when the factorisation fails or the solution is not finite."""
     R = np.ascontiguousarray(R, dtype=np.float64)
     n = A.shape[0]
     if n == 0:
@@ -77,19 +88,19 @@ def cholesky_solve(A, R):
     try:
         from cholespy import CholeskySolverD, MatrixType
     except ImportError:  # pragma: no cover - cholespy is a dependency
-        import scipy.sparse.linalg as spla
-        try:
-            X = spla.splu(sp.csc_matrix(A)).solve(R)
-        except RuntimeError as exc:
-            raise SolverError(f"sparse LU failed: {exc}") from None
-    else:
+        prefer_lu = True
+    X = None
+    if not prefer_lu:
         try:
             solver = CholeskySolverD(n, A.indptr.astype(np.int32), A.indices.astype(np.int32),
                                      np.ascontiguousarray(A.data), MatrixType.CSR)
-        except (ValueError, RuntimeError) as exc:
-            raise SolverError(f"sparse Cholesky factorisation failed: {exc}") from None
-        X = np.empty_like(R)
-        solver.solve(R, X)
+        except (ValueError, RuntimeError):
+            X = None          # not numerically positive definite: LU below
+        else:
+            X = np.empty_like(R)
+            solver.solve(R, X)
+    if X is None:
+        X = _splu_solve(A, R)
     if not np.isfinite(X).all():
         raise SolverError("the sparse direct solve produced non-finite values (matrix numerically singular)")
     return X
@@ -195,8 +206,11 @@ class HHJSystem:
         info = SolveInfo(solver=solver, iterations=0, switched=False)
         if solver == "auto" and n <= AUTO_DIRECT_MAX:
             solver = "direct"
+        # faces whose 3x3 block is numerically singular make A numerically semi-definite:
+        # LU with pivoting instead of Cholesky there
+        prefer_lu = self.n_jacobi_faces > 0
         if solver == "direct":
-            X = cholesky_solve(self.csr(), rhs)
+            X = cholesky_solve(self.csr(), rhs, prefer_lu=prefer_lu)
             info["solver"] = "direct"
         else:
             M = (self.indptr, self._cols_flat, self.M.ravel())
@@ -220,7 +234,7 @@ class HHJSystem:
                             f"preconditioned CG did not converge in {it} iterations (relative residual "
                             f"{max(relres):.2e} > {rtol:.1e}) and the system ({n} unknowns) is too large "
                             f"for the direct solver")
-                    X = cholesky_solve(self.csr(), rhs)
+                    X = cholesky_solve(self.csr(), rhs, prefer_lu=prefer_lu)
                     info["switched"] = True
                     info["solver"] = "direct"
                 else:

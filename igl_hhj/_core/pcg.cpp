@@ -106,6 +106,7 @@ void update(i64 n, int k, const double* alpha, double* X, double* r, const doubl
 // Column j stops when |r_j| <= rtol |R_j|.  Every probe_iter iterations (0: never) the
 // iterations still needed are extrapolated from the mean rate so far; above
 // max_predicted the solve stops early (status 2) so the caller can switch solvers.
+// Status 3: breakdown (p.Ap <= 0 or the residual grew 1e4-fold: A numerically singular).
 PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const double* Ax,
                     const i64* Mp, const std::int32_t* Mi, const double* Mx, const double* dinv,
                     const double* R, double* X, double rtol, i64 maxiter,
@@ -148,7 +149,12 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
     for (i64 it = 1; it <= maxiter; ++it) {
         apply_and_dot(n, k, Ap, Ai, Ax, nullptr, p.data(), q.data(), p.data(), P, nt);
         P.reduce(pq);
-        for (int j = 0; j < k; ++j) alpha[j] = active[j] ? rz[j] / pq[j] : 0.0;
+        bool breakdown = false;
+        for (int j = 0; j < k; ++j) {
+            alpha[j] = active[j] ? rz[j] / pq[j] : 0.0;
+            breakdown = breakdown || (active[j] && !(pq[j] > 0.0 && std::isfinite(alpha[j])));
+        }
+        if (breakdown) { res.status = 3; res.iterations = it; break; }
         update(n, k, alpha.data(), X, r.data(), p.data(), q.data(), P, nt);
         P.reduce(rr);
         res.iterations = it;
@@ -156,7 +162,10 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
         for (int j = 0; j < k; ++j) {
             active[j] = active[j] && rr[j] > tol2[j];
             any = any || active[j];
+            // divergence in floating point (A numerically singular): residual up 1e4x
+            breakdown = breakdown || !std::isfinite(rr[j]) || rr[j] > 1e8 * bb[j];
         }
+        if (breakdown) { res.status = 3; break; }
         if (!any) { res.status = 0; break; }
         if (probe_iter > 0 && it % probe_iter == 0 && rtol > 0) {
             double worst = 0.0;
