@@ -137,12 +137,16 @@ def ell_indptr(n, width=5):
 
 
 def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,
-              probe_iter=0, max_predicted=np.inf):
+              probe_iter=0, max_predicted=np.inf, subdomain=None, subdomain_solve=None):
     """Fused block PCG on all columns of ``R`` (n, k ≤ 16) for a CSR matrix.
 
     Column indices travel as int32 (memory bandwidth: the sweeps are memory-bound).
     Reference: :func:`igl_hhj.hhj._block_pcg`.  Preconditioner: ``M`` =
-    ``(indptr, indices, data)`` of a CSR matrix, else Jacobi with ``dinv``.
+    ``(indptr, indices, data)`` of a CSR matrix, else Jacobi with ``dinv``; with
+    ``subdomain`` (int64 indices S) and ``subdomain_solve(r_S, z_S)`` (writes
+    ``z_S = C r_S`` into its second argument, (|S|, k) float64) a second level
+    ``z += R_Sᵀ C R_S r`` is added (e.g. an exact sparse solve on the DOFs of
+    badly shaped faces).
 
     Returns
     -------
@@ -176,8 +180,14 @@ def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,
             raise ValueError(f"dinv must be ({n},), got {dinv.shape}")
     else:
         raise ValueError("block_pcg needs M or dinv")
+    S = None
+    if subdomain is not None:
+        S = _i64(subdomain)
+        if subdomain_solve is None or not callable(subdomain_solve):
+            raise TypeError("subdomain needs a callable subdomain_solve(r_S, z_S)")
     return _core.block_pcg(indptr, indices, data, Mp, Mi, Mx, dinv, R, float(rtol), int(maxiter),
-                           int(probe_iter), float(max_predicted))
+                           int(probe_iter), float(max_predicted), S,
+                           subdomain_solve if S is not None else None)
 
 
 def shape_operator_faces(mesh, s):

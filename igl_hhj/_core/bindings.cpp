@@ -132,7 +132,8 @@ NB_MODULE(_hhj_core, m) {
     m.def("block_pcg", [](In<i64> Ap, In<std::int32_t> Ai, In<double> Ax, std::optional<In<i64>> Mp,
                           std::optional<In<std::int32_t>> Mi, std::optional<In<double>> Mx,
                           std::optional<In<double>> dinv, In<double> R, double rtol, i64 maxiter,
-                          i64 probe_iter, double max_predicted) {
+                          i64 probe_iter, double max_predicted, std::optional<In<i64>> S,
+                          std::optional<nb::callable> subdomain_solve) {
         need(R.ndim() == 2, "block_pcg: R must be (n, k)");
         const i64 n = R.shape(0);
         const int k = (int)R.shape(1);
@@ -141,13 +142,30 @@ NB_MODULE(_hhj_core, m) {
              "block_pcg: need a preconditioner (CSR) or dinv (n,)");
         std::vector<double> X((size_t)n * k);
         hhj::PCGResult res;
+        hhj::SubdomainSolve sub;
+        if (S && subdomain_solve) {
+            sub.S = S->data();
+            sub.nS = (i64)S->shape(0);
+            for (i64 i = 0; i < sub.nS; ++i) need(sub.S[i] >= 0 && sub.S[i] < n, "block_pcg: S index out of range");
+            const size_t nS = sub.nS, kk = k;
+            nb::callable fn = *subdomain_solve;
+            sub.solve = [fn, nS, kk](const double* rS, double* zS) {
+                nb::gil_scoped_acquire gil;
+                // rS is a scratch buffer: writable, so that solvers taking writable input accept it
+                nb::ndarray<nb::numpy, double> a(const_cast<double*>(rS), {nS, kk});
+                nb::ndarray<nb::numpy, double> b(zS, {nS, kk});
+                // reference policy: the callee writes into zS itself (no copies)
+                fn(nb::cast(a, nb::rv_policy::reference), nb::cast(b, nb::rv_policy::reference));
+            };
+        }
         {
             nb::gil_scoped_release nogil;
             hhj::ThreadBudget tb(n);
             res = hhj::block_pcg(n, k, Ap.data(), Ai.data(), Ax.data(),
                                  Mp ? Mp->data() : nullptr, Mp ? Mi->data() : nullptr,
                                  Mp ? Mx->data() : nullptr, dinv ? dinv->data() : nullptr,
-                                 R.data(), X.data(), rtol, maxiter, probe_iter, max_predicted, tb.nt);
+                                 R.data(), X.data(), rtol, maxiter, probe_iter, max_predicted, tb.nt,
+                                 sub.nS ? &sub : nullptr);
         }
         return nb::make_tuple(to_numpy(std::move(X), {(size_t)n, (size_t)k}), res.iterations, res.status,
                               res.relres);

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -116,9 +117,17 @@ struct PCGResult {
     int status = 0;              // 0 converged, 1 iteration cap, 2 stopped early (slow)
     std::vector<double> relres;  // per column
 };
+// Optional second level of the preconditioner: z += R_S^T C (R_S r) on the index set S,
+// C given as a function (rS (nS,k) -> zS (nS,k)), e.g. an exact sparse solve.
+struct SubdomainSolve {
+    const i64* S = nullptr;
+    i64 nS = 0;
+    std::function<void(const double*, double*)> solve;
+};
 PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const double* Ax,
                     const i64* Mp, const std::int32_t* Mi, const double* Mx, const double* dinv,
                     const double* R, double* X, double rtol, i64 maxiter,
-                    i64 probe_iter, double max_predicted, int nt);
+                    i64 probe_iter, double max_predicted, int nt,
+                    const SubdomainSolve* sub = nullptr);
 
 }  // namespace hhj

@@ -110,7 +110,7 @@ void update(i64 n, int k, const double* alpha, double* X, double* r, const doubl
 PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const double* Ax,
                     const i64* Mp, const std::int32_t* Mi, const double* Mx, const double* dinv,
                     const double* R, double* X, double rtol, i64 maxiter,
-                    i64 probe_iter, double max_predicted, int nt) {
+                    i64 probe_iter, double max_predicted, int nt, const SubdomainSolve* sub) {
     if (k > 16) throw std::invalid_argument("block_pcg: at most 16 right-hand sides per call");
     PCGResult res;
     res.relres.assign(k, 0.0);
@@ -142,8 +142,25 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
         any = any || active[j];
     }
     if (!any || n == 0) return res;
-    apply_and_dot(n, k, Mp, Mi, Mx, dinv, r.data(), z.data(), r.data(), P, nt);
-    P.reduce(rz);
+    std::vector<double> rS, zS;
+    if (sub && sub->nS > 0) { rS.resize((size_t)sub->nS * k); zS.resize((size_t)sub->nS * k); }
+    // z = M r (+ R_S^T C R_S r), out = r.z; the second level's share of r.z is summed
+    // serially over S in a fixed order (deterministic).
+    auto precondition = [&](std::vector<double>& out) {
+        apply_and_dot(n, k, Mp, Mi, Mx, dinv, r.data(), z.data(), r.data(), P, nt);
+        P.reduce(out);
+        if (rS.empty()) return;
+        for (i64 i = 0; i < sub->nS; ++i)
+            for (int j = 0; j < k; ++j) rS[(size_t)i * k + j] = r[(size_t)sub->S[i] * k + j];
+        sub->solve(rS.data(), zS.data());
+        for (i64 i = 0; i < sub->nS; ++i)
+            for (int j = 0; j < k; ++j) {
+                const size_t s = (size_t)sub->S[i] * k + j;
+                z[s] += zS[(size_t)i * k + j];
+                out[j] += rS[(size_t)i * k + j] * zS[(size_t)i * k + j];
+            }
+    };
+    precondition(rz);
     std::copy(z.begin(), z.end(), p.begin());
     res.status = 1;
     for (i64 it = 1; it <= maxiter; ++it) {
@@ -178,8 +195,7 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
                 res.status = 2; break;
             }
         }
-        apply_and_dot(n, k, Mp, Mi, Mx, dinv, r.data(), z.data(), r.data(), P, nt);
-        P.reduce(rz_new);
+        precondition(rz_new);
         for (int j = 0; j < k; ++j) {
             beta[j] = active[j] ? rz_new[j] / rz[j] : 0.0;
             rz[j] = rz_new[j];
