@@ -14,7 +14,14 @@ count.
 """
 from __future__ import annotations
 
+import os
+
 import numpy as np
+
+# Idle OpenMP threads sleep instead of spinning (libgomp reads this when the extension
+# loads it).  Measured on the shared 2-core machine (load 8): with the default spinning,
+# two threads made the drop-in 1.8x slower than one; passive waiting made them equal.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 try:
     from . import _hhj_core as _core
@@ -48,14 +55,35 @@ def _i32(a):
     return np.ascontiguousarray(a, dtype=np.int32)
 
 
+_USER_THREADS = _core.max_threads()     # OMP_NUM_THREADS or the core count
+# Run single-threaded while the machine is already busy (1-minute load average ≥ the
+# number of cores): extra threads then only queue behind other processes.  Results do
+# not depend on the thread count (fixed-chunk reductions).
+ADAPT_TO_LOAD = True
+
+
 def max_threads():
     """Number of OpenMP threads a kernel may use (1 without OpenMP)."""
     return _core.max_threads()
 
 
 def set_num_threads(n):
-    """Set the OpenMP thread count of the calling thread's kernels (``omp_set_num_threads``)."""
-    _core.set_num_threads(int(n))
+    """Set the OpenMP thread count of igl_hhj's kernels (``omp_set_num_threads``)."""
+    global _USER_THREADS
+    _USER_THREADS = max(1, int(n))
+    _core.set_num_threads(_USER_THREADS)
+
+
+def _threads():
+    """Apply the thread policy for the next kernel call (calling thread only)."""
+    n = _USER_THREADS
+    if ADAPT_TO_LOAD and n > 1:
+        try:
+            if os.getloadavg()[0] >= (os.cpu_count() or 1):
+                n = 1
+        except OSError:  # pragma: no cover - no load average on this platform
+            pass
+    _core.set_num_threads(n)
 
 
 def topology(F, n_vertices):
@@ -120,6 +148,7 @@ def hhj_system(mesh, fixed=None, schwarz=True, topology=None):
     if FE.shape != (mesh.n_faces, 3) or EF.shape != (nE, 2) or ELI.shape != (nE, 2) \
             or (fx is not None and fx.shape != (nE,)):
         raise ValueError("hhj_system: topology arrays do not match the mesh")
+    _threads()
     return _core.hhj_system(mesh.V, mesh.F, FE, EF, ELI, fx, bool(schwarz))
 
 
@@ -128,6 +157,7 @@ def jump_apply(mesh, W):
     W = _f64(W, "W")
     if W.ndim != 2 or W.shape[0] != mesh.n_vertices:
         raise ValueError(f"W must have shape ({mesh.n_vertices}, k), got {W.shape}")
+    _threads()
     return _core.jump_apply(mesh.V, mesh.F, _i64(mesh.edge_faces), _i64(mesh.edge_local_index), W)
 
 
@@ -185,6 +215,7 @@ def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,
         S = _i64(subdomain)
         if subdomain_solve is None or not callable(subdomain_solve):
             raise TypeError("subdomain needs a callable subdomain_solve(r_S, z_S)")
+    _threads()
     return _core.block_pcg(indptr, indices, data, Mp, Mi, Mx, dinv, R, float(rtol), int(maxiter),
                            int(probe_iter), float(max_predicted), S,
                            subdomain_solve if S is not None else None)
@@ -195,6 +226,7 @@ def shape_operator_faces(mesh, s):
 
     Reference: :func:`igl_hhj.hhj.face_tensors` contracted with the face normals."""
     s = _f64(s, "s", (3,))
+    _threads()
     return _core.shape_operator_faces(mesh.V, mesh.F, _i64(mesh.face_edges), s)
 
 
@@ -203,6 +235,7 @@ def face_tensors(mesh, s):
     s = _f64(s, "s")
     if s.ndim != 2 or s.shape[0] != mesh.n_edges:
         raise ValueError(f"s must have shape ({mesh.n_edges}, k), got {s.shape}")
+    _threads()
     return _core.face_tensors(mesh.V, mesh.F, _i64(mesh.face_edges), s)
 
 
@@ -229,4 +262,5 @@ def principal_2x2(S, N):
     N = _f64(N, "N", (3,))
     if S.shape[0] != N.shape[0]:
         raise ValueError(f"S and N must have the same length, got {S.shape[0]} and {N.shape[0]}")
+    _threads()
     return _core.principal_2x2(S, N)

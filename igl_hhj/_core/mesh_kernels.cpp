@@ -95,7 +95,8 @@ void edge_morton_order(const double* V, i64 nV, const i64* E, i64 nE, i64* perm)
     double scale = 0.0;
     for (int a = 0; a < 3; ++a) scale = std::max(scale, hi[a] - lo[a]);
     scale = scale > 0 ? 2097151.0 / scale : 0.0;
-    std::vector<std::pair<std::uint64_t, i64>> key(nE);
+    std::vector<std::uint64_t> key(nE), key2(nE);
+    std::vector<i64> idx(nE), idx2(nE);
     for (i64 e = 0; e < nE; ++e) {
         std::uint64_t code = 0;
         for (int a = 0; a < 3; ++a) {
@@ -104,10 +105,25 @@ void edge_morton_order(const double* V, i64 nV, const i64* E, i64 nE, i64* perm)
             q = q < 0 ? 0 : (q > 2097151.0 ? 2097151.0 : q);
             code |= spread3((std::uint64_t)q) << a;
         }
-        key[e] = {code, e};
+        key[e] = code;
+        idx[e] = e;
     }
-    std::sort(key.begin(), key.end());
-    for (i64 e = 0; e < nE; ++e) perm[e] = key[e].second;
+    // LSD radix sort, 16-bit digits over the 63-bit codes (stable: ties keep index order)
+    std::vector<i64> cnt(65537);
+    for (int pass = 0; pass < 4; ++pass) {
+        const int shift = 16 * pass;
+        std::fill(cnt.begin(), cnt.end(), 0);
+        for (i64 e = 0; e < nE; ++e) ++cnt[((key[e] >> shift) & 0xffff) + 1];
+        for (int d = 0; d < 65536; ++d) cnt[d + 1] += cnt[d];
+        for (i64 e = 0; e < nE; ++e) {
+            const i64 dst = cnt[(key[e] >> shift) & 0xffff]++;
+            key2[dst] = key[e];
+            idx2[dst] = idx[e];
+        }
+        key.swap(key2);
+        idx.swap(idx2);
+    }
+    for (i64 e = 0; e < nE; ++e) perm[e] = idx[e];
 }
 
 }  // namespace hhj
