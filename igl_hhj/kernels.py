@@ -134,7 +134,7 @@ def hhj_system(mesh, fixed=None, schwarz=True, topology=None):
 
     Returns
     -------
-    cols : (#E, 5) int64, column of each slot (slot 0 = the diagonal; unused
+    cols : (#E, 5) int32, column of each slot (slot 0 = the diagonal; unused
         slots point at the diagonal with value 0)
     A : (#E, 5) float64, ``A[e, e'] = Σ_T |T| φ_e : φ_e'`` (Walker eq. 5.14)
     M : (#E, 5) float64 or None, ``Σ_T R_Tᵀ (R_T A R_Tᵀ)⁻¹ R_T`` (same columns)

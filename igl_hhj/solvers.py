@@ -180,7 +180,7 @@ class HHJSystem:
         else:
             self.A = self.A_full
         self.indptr = kernels.ell_indptr(n)
-        self._cols_flat = self.cols.ravel().astype(np.int32)
+        self._cols_flat = self.cols.ravel()              # int32 (memory-bound sweeps)
 
     @property
     def n(self):

@@ -18,3 +18,13 @@ def test_speed_run_quick():
 def test_min_angle_of_equilateral_triangle():
     V = np.array([[0.0, 0, 0], [1, 0, 0], [0.5, np.sqrt(3) / 2, 0]])
     assert abs(speed.min_angle_degrees(V, np.array([[0, 1, 2]])) - 60.0) < 1e-9
+
+
+def test_rtol_study_small():
+    rows = speed.rtol_study(faces=(5_000,), rtols=(1e-4, 1e-12), torus_levels=0)
+    assert len(rows) == 4
+    tight = [r for r in rows if r["rtol"] == 1e-12]
+    loose = [r for r in rows if r["rtol"] == 1e-4]
+    assert all(r["change"] == 0 for r in tight)
+    assert all(lo["iterations"] < ti["iterations"] for lo, ti in zip(loose, tight))
+    assert "change vs rtol 1e-12" in speed.rtol_markdown(rows)

@@ -90,7 +90,8 @@ NB_MODULE(_hhj_core, m) {
         const i64 nF = F.shape(0), nE = EF.shape(0);
         need(FE.shape(0) == (size_t)nF && ELI.shape(0) == (size_t)nE, "hhj_system: inconsistent shapes");
         need(!fixed || fixed->shape(0) == (size_t)nE, "hhj_system: fixed must be (#E,)");
-        std::vector<i64> cols((size_t)nE * 5);
+        need(nE < ((i64)1 << 31), "hhj_system: at most 2**31 - 1 edges");
+        std::vector<std::int32_t> cols((size_t)nE * 5);
         std::vector<double> A((size_t)nE * 5), M;
         i64 n_jacobi = 0;
         {
@@ -105,8 +106,7 @@ NB_MODULE(_hhj_core, m) {
                 n_jacobi = hhj::face_schwarz(Aloc.data(), diag.data(), FE.data(),
                                              fixed ? fixed->data() : nullptr, nF, inv.data(), tb.nt);
                 M.resize((size_t)nE * 5);
-                std::vector<i64> cols2((size_t)nE * 5);
-                hhj::assemble_ell(inv.data(), FE.data(), EF.data(), ELI.data(), nE, cols2.data(), M.data(), tb.nt);
+                hhj::assemble_ell(inv.data(), FE.data(), EF.data(), ELI.data(), nE, nullptr, M.data(), tb.nt);
             }
         }
         const size_t ne = nE;

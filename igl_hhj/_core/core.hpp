@@ -97,7 +97,7 @@ void edge_morton_order(const double* V, i64 nV, const i64* E, i64 nE, i64* perm)
 // hhj_kernels.cpp
 void local_mass(const double* V, const i64* F, i64 nF, double* Aloc);
 void assemble_ell(const double* Aloc, const i64* FE, const i64* EF, const i64* ELI, i64 nE,
-                  i64* cols, double* vals, int nt);
+                  std::int32_t* cols, double* vals, int nt);
 i64 face_schwarz(const double* Aloc, const double* diag, const i64* FE, const unsigned char* fixed,
                  i64 nF, double* inv, int nt);
 void jump_apply(const double* V, const i64* F, i64 nF, const i64* EF, const i64* ELI, i64 nE,

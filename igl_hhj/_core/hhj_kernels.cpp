@@ -51,28 +51,33 @@ void local_mass(const double* V, const i64* F, i64 nF, double* Aloc) {
 // assemble_ell: sum of face blocks blk[f] (#F,3,3) into a fixed-width row format
 // (#E, 5): slot 0 = diagonal (sum over the edge's faces), slots 1-2 / 3-4 = the
 // couplings to the other two edges of the face on side 0 / side 1 (col = e,
-// value 0 when the side is missing).  The same layout serves A and the Schwarz M.
+// value 0 when the side is missing).  The same layout serves A and the Schwarz M
+// (cols may be nullptr when the columns are already known).  Columns are int32.
 void assemble_ell(const double* blk, const i64* FE, const i64* EF, const i64* ELI, i64 nE,
-                  i64* cols, double* vals, int nt) {
+                  std::int32_t* cols, double* vals, int nt) {
 #ifdef IGL_HHJ_OPENMP
 #pragma omp parallel for schedule(static) num_threads(nt)
 #endif
     for (i64 e = 0; e < nE; ++e) {
         double d = 0.0;
-        cols[5 * e] = e;
+        if (cols) cols[5 * e] = (std::int32_t)e;
         for (int s = 0; s < 2; ++s) {
             const i64 f = EF[2 * e + s];
             if (f < 0) {
-                cols[5 * e + 1 + 2 * s] = e; vals[5 * e + 1 + 2 * s] = 0.0;
-                cols[5 * e + 2 + 2 * s] = e; vals[5 * e + 2 + 2 * s] = 0.0;
+                if (cols) cols[5 * e + 1 + 2 * s] = cols[5 * e + 2 + 2 * s] = (std::int32_t)e;
+                vals[5 * e + 1 + 2 * s] = vals[5 * e + 2 + 2 * s] = 0.0;
                 continue;
             }
             const int i = (int)ELI[2 * e + s];
             const double* B = blk + 9 * f;
             d += B[4 * i];
             const int a = (i + 1) % 3, b = (i + 2) % 3;
-            cols[5 * e + 1 + 2 * s] = FE[3 * f + a]; vals[5 * e + 1 + 2 * s] = B[3 * i + a];
-            cols[5 * e + 2 + 2 * s] = FE[3 * f + b]; vals[5 * e + 2 + 2 * s] = B[3 * i + b];
+            if (cols) {
+                cols[5 * e + 1 + 2 * s] = (std::int32_t)FE[3 * f + a];
+                cols[5 * e + 2 + 2 * s] = (std::int32_t)FE[3 * f + b];
+            }
+            vals[5 * e + 1 + 2 * s] = B[3 * i + a];
+            vals[5 * e + 2 + 2 * s] = B[3 * i + b];
         }
         vals[5 * e] = d;
     }

@@ -15,27 +15,33 @@ namespace hhj {
 // runs min->max).  On non-manifold edges (count > 2) the last faces win.
 void topology(const i64* F, i64 nF, i64 nV, Topology& T) {
     const i64 nH = 3 * nF;
-    std::vector<i64> start(nV + 1, 0);
-    auto ends = [&](i64 h, i64& lo, i64& hi) {
-        const i64 f = h / 3, i = h % 3;
-        const i64 a = F[3 * f + (i + 1) % 3], b = F[3 * f + (i + 2) % 3];
-        lo = a < b ? a : b;
-        hi = a < b ? b : a;
-    };
-    for (i64 h = 0; h < nH; ++h) { i64 lo, hi; ends(h, lo, hi); ++start[lo + 1]; }
+    std::vector<i64> start(nV + 1, 0), lo(nH), hikey(nH);
+    for (i64 f = 0; f < nF; ++f)
+        for (int i = 0; i < 3; ++i) {
+            const i64 a = F[3 * f + (i + 1) % 3], b = F[3 * f + (i + 2) % 3];
+            const i64 h = 3 * f + i;
+            lo[h] = a < b ? a : b;
+            hikey[h] = a < b ? b : a;
+            ++start[lo[h] + 1];
+        }
     for (i64 v = 0; v < nV; ++v) start[v + 1] += start[v];
     std::vector<i64> order(nH), fill(start.begin(), start.end() - 1);
-    std::vector<i64> hikey(nH);
-    for (i64 h = 0; h < nH; ++h) {
-        i64 lo, hi; ends(h, lo, hi);
-        order[fill[lo]++] = h;
-        hikey[h] = hi;
-    }
-    // sort each bucket by (hi, h): buckets are small (vertex valence)
+    for (i64 h = 0; h < nH; ++h) order[fill[lo[h]]++] = h;
+    // sort each bucket by (hi, h): buckets are small (vertex valence), insertion sort;
+    // h ascending within a bucket already (counting sort is stable)
     for (i64 v = 0; v < nV; ++v) {
         i64* b = order.data() + start[v];
-        i64* e = order.data() + start[v + 1];
-        std::sort(b, e, [&](i64 x, i64 y) { return hikey[x] != hikey[y] ? hikey[x] < hikey[y] : x < y; });
+        const i64 m = start[v + 1] - start[v];
+        if (m > 32) {
+            std::stable_sort(b, b + m, [&](i64 x, i64 y) { return hikey[x] < hikey[y]; });
+            continue;
+        }
+        for (i64 p = 1; p < m; ++p) {
+            const i64 h = b[p], key = hikey[h];
+            i64 q = p - 1;
+            while (q >= 0 && hikey[b[q]] > key) { b[q + 1] = b[q]; --q; }
+            b[q + 1] = h;
+        }
     }
     T.face_edges.assign(nH, 0);
     T.sign.assign(nH, 0.0);

@@ -2,6 +2,7 @@
 measured in the same run.
 
     python -m igl_hhj.benchmarks.speed [--quick] [--repeat 3] [--meshes DIR] [--out DIR]
+    python -m igl_hhj.benchmarks.speed --rtol-study
 
 Meshes: icosphere(7) (328k faces) and icosphere(8) (1.31M), a jittered ellipsoid at
 82k / 328k / 1.31M faces (linear-scaling check), Walker's torus from a perturbed grid
@@ -193,6 +194,54 @@ def run(names=FULL, repeat=3, mesh_dir=None, progress=True, memory=True):
     return rows
 
 
+RTOLS = (1e-3, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
+
+
+def rtol_study(faces=(20_000, 80_000, 320_000), rtols=RTOLS, torus_levels=3):
+    """How the PCG tolerance shows in the drop-in's error against the exact surface.
+
+    Jittered ellipsoids (exact principal curvatures known) and Walker's sliver torus;
+    for each ``rtol``: PCG iterations and the L2 vertex error of H = (κ1+κ2)/2
+    relative to the same error at rtol = 1e-12.
+
+    Returns
+    -------
+    list of dict rows: ``mesh, faces, rtol, iterations, err_H, change``.
+    """
+    from igl_hhj.convergence import vertex_errors
+    from igl_hhj.curvature import _shape_operator, vertex_principal_curvature, vertex_shape_operator
+    from igl_hhj.mesh import TriangleMesh
+    from ..surfaces import Ellipsoid, WalkerTorus, refine, torus_coarse
+    cases = [("jittered ellipsoid", Ellipsoid(), *_ellipsoid(n)) for n in faces]
+    V, F = torus_coarse(n_phi=32, n_t=16, amount=0.25)
+    cases.append(("Walker torus (sliver grid)", WalkerTorus(), *refine(V, F, WalkerTorus(), torus_levels)))
+    rows = []
+    for label, surface, V, F in cases:
+        m = TriangleMesh(V, F)
+        errs = {}
+        for rtol in sorted(rtols, reverse=False):
+            info = {}
+            S = _shape_operator(m, None, None, None, "cg", rtol, info)
+            Sv, N = vertex_shape_operator(m, S)
+            _, _, PV1, PV2 = vertex_principal_curvature(m, Sv, N)
+            errs[rtol] = (vertex_errors(m, None, PV1, PV2, surface)["H"], info["iterations"])
+        ref = errs[min(rtols)][0]
+        for rtol in rtols:
+            e, it = errs[rtol]
+            rows.append({"mesh": label, "faces": len(F), "rtol": rtol, "iterations": it,
+                         "err_H": e, "change": abs(e - ref) / ref})
+    return rows
+
+
+def rtol_markdown(rows):
+    lines = ["| mesh | faces | rtol | PCG its | L2 error of H at vertices | change vs rtol 1e-12 |",
+             "|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['mesh']} | {r['faces']:,} | {r['rtol']:.0e} | {r['iterations']} | "
+                     f"{r['err_H']:.4e} | {100 * r['change']:.4f} % |")
+    return "\n".join(lines)
+
+
 def markdown(rows):
     head = ["mesh", "faces", "min angle", "libigl (s)", "drop-in (s)", "ratio", "µs/face",
             "S_h direct (s)", "S_h cg (s)", "S_h auto (s)", "auto chose", "PCG its",
@@ -217,7 +266,16 @@ def main(argv=None):
     p.add_argument("--meshes", default=None, help="folder of real meshes (default ../shared/data/meshes)")
     p.add_argument("--no-memory", action="store_true", help="skip the fresh-process memory column")
     p.add_argument("--out", default="benchmark-results")
+    p.add_argument("--rtol-study", action="store_true",
+                   help="only the tolerance study (PCG iterations and error vs rtol)")
     a = p.parse_args(argv)
+    if a.rtol_study:
+        table = rtol_markdown(rtol_study())
+        print(table)
+        out = Path(a.out)
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "speed_rtol.md").write_text(table + "\n")
+        return
     rows = run(QUICK if a.quick else FULL, a.repeat, a.meshes, memory=not a.no_memory)
     table = markdown(rows)
     import importlib.metadata
