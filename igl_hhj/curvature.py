@@ -121,15 +121,20 @@ def _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supp
     """Compiled path of :func:`shape_operator` (reference: :func:`_shape_operator_reference`)."""
     clamped, ss_edges = _boundary_partition(mesh, boundary_normals, boundary_shape_operator,
                                             simply_supported)
-    rhs = -kernels.jump_apply(mesh, mesh.V)                   # -B X, (#E, 3)
-    _boundary_rhs(mesh, rhs, clamped, boundary_normals)
+    if clamped.any():                                         # check the data before the work
+        _normalised_boundary_normals(mesh, boundary_normals, clamped)
     fixed = ss_edges if ss_edges.any() else None
-    system = HHJSystem(mesh, fixed=fixed)
-    if fixed is not None:                                     # eq. 5.18/5.19: move ρ to the load
+    if fixed is not None:
         rho = _simply_supported_values(mesh, boundary_shape_operator, ss_edges)
+    system = HHJSystem(mesh, fixed=fixed)
+    rhs = kernels.jump_apply(mesh, mesh.V)                    # B X, (#E, 3)
+    np.negative(rhs, out=rhs)                                 # -B X
+    _boundary_rhs(mesh, rhs, clamped, boundary_normals)
+    if fixed is not None:                                     # eq. 5.18/5.19: move ρ to the load
         rhs -= system.fixed_coupling(rho)
         rhs[fixed] = 0.0
-    s, solve_info = system.solve(rhs, solver, rtol)           # (#E, 3): σ^k DOFs
+    s, solve_info = system.solve(rhs, solver, rtol, overwrite_rhs=True)   # (#E, 3): σ^k DOFs
+    del rhs
     if fixed is not None:
         s[fixed] = rho[fixed]
     if info is not None:

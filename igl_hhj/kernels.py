@@ -139,6 +139,8 @@ def hhj_system(mesh, fixed=None, schwarz=True, topology=None):
     A : (#E, 5) float64, ``A[e, e'] = Σ_T |T| φ_e : φ_e'`` (Walker eq. 5.14)
     M : (#E, 5) float64 or None, ``Σ_T R_Tᵀ (R_T A R_Tᵀ)⁻¹ R_T`` (same columns)
     n_jacobi : int, faces whose block was numerically singular and got Jacobi instead
+    sin_min_angle : (#F,) float64, sine of each face's smallest angle,
+        ``2|T| l_min / (l_0 l_1 l_2)``
     """
     fx = None if fixed is None else np.ascontiguousarray(fixed, dtype=np.uint8)
     FE, EF, ELI = topology if topology is not None else \
@@ -167,7 +169,8 @@ def ell_indptr(n, width=5):
 
 
 def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,
-              probe_iter=0, max_predicted=np.inf, subdomain=None, subdomain_solve=None):
+              probe_iter=0, max_predicted=np.inf, subdomain=None, subdomain_solve=None,
+              overwrite_R=False):
     """Fused block PCG on all columns of ``R`` (n, k ≤ 16) for a CSR matrix.
 
     Column indices travel as int32 (memory bandwidth: the sweeps are memory-bound).
@@ -188,7 +191,8 @@ def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,
         10⁴-fold: the matrix is numerically singular or not SPD)
     relres : list of float, final relative residual per column
     """
-    R = _f64(R, "R")
+    R = np.asarray(R, dtype=np.float64, order="C") if overwrite_R else \
+        np.array(R, dtype=np.float64, order="C", copy=True)
     if R.ndim != 2:
         raise ValueError(f"R must be (n, k), got {R.shape}")
     n = R.shape[0]

@@ -147,6 +147,8 @@ class TriangleMesh:
         self.F = validate_faces(F, self.V.shape[0])
         self._check_degenerate()
         self._check_manifold_and_orientation()
+        # the (#F, 3, 3) edge vectors are recomputed on demand (memory: 72 B/face)
+        self.__dict__.pop("_edge_vectors", None)
 
     # ------------------------------------------------------------------ sizes
     @property

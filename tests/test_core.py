@@ -88,7 +88,7 @@ def test_topology_equals_libigl_reference(name):
 @pytest.mark.parametrize("name", ["closed", "open", "sliver"])
 def test_assembly_and_schwarz_equal_reference(name):
     m = TriangleMesh(*_meshes()[name])
-    cols, A, M, _ = kernels.hhj_system(m)
+    cols, A, M, _, sin_min = kernels.hhj_system(m)
     n = m.n_edges
     rows = np.repeat(np.arange(n), 5)
     Ac = sp.csr_matrix((A.ravel(), (rows, cols.ravel())), shape=(n, n))
@@ -97,6 +97,8 @@ def test_assembly_and_schwarz_equal_reference(name):
     assert abs(Ac - Aref).max() <= RTOL * abs(Aref).max()
     Mref = face_schwarz_preconditioner(m, Aref)
     assert abs(Mc - Mref).max() <= RTOL * abs(Mref).max()
+    l = m.edge_lengths
+    assert rel(sin_min, m.face_double_areas * l.min(axis=1) / l.prod(axis=1)) <= 1e-12
     W = np.random.default_rng(1).normal(size=(m.n_vertices, 3))
     Bw = kernels.jump_apply(m, W)
     assert rel(Bw, jump_matrix(m) @ W) <= RTOL
@@ -182,7 +184,7 @@ def test_sliver_face_schwarz_never_raises():
     m = TriangleMesh(V, F)
     M = face_schwarz_preconditioner(m, mass_matrix(m))
     assert np.isfinite(M.data).all()
-    cols, A, Mk, n_jacobi = kernels.hhj_system(m)
+    cols, A, Mk, n_jacobi, _ = kernels.hhj_system(m)
     assert n_jacobi >= 1 and np.isfinite(Mk).all()
     for solver in ("direct", "auto"):
         S = igl_hhj.shape_operator(V, F, solver=solver)

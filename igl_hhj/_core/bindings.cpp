@@ -92,28 +92,29 @@ NB_MODULE(_hhj_core, m) {
         need(!fixed || fixed->shape(0) == (size_t)nE, "hhj_system: fixed must be (#E,)");
         need(nE < ((i64)1 << 31), "hhj_system: at most 2**31 - 1 edges");
         std::vector<std::int32_t> cols((size_t)nE * 5);
-        std::vector<double> A((size_t)nE * 5), M;
+        std::vector<double> A((size_t)nE * 5), M, sin_min(nF);
         i64 n_jacobi = 0;
         {
             nb::gil_scoped_release nogil;
             hhj::ThreadBudget tb(nF);
             std::vector<double> Aloc((size_t)nF * 9);
-            hhj::local_mass(V.data(), F.data(), nF, Aloc.data());
+            hhj::local_mass(V.data(), F.data(), nF, Aloc.data(), sin_min.data());
             hhj::assemble_ell(Aloc.data(), FE.data(), EF.data(), ELI.data(), nE, cols.data(), A.data(), tb.nt);
             if (schwarz) {
-                std::vector<double> diag(nE), inv((size_t)nF * 9);
+                std::vector<double> diag(nE);
                 for (i64 e = 0; e < nE; ++e) diag[e] = A[5 * e];
+                // the face inverses overwrite the local blocks (memory: one #F x 9 buffer)
                 n_jacobi = hhj::face_schwarz(Aloc.data(), diag.data(), FE.data(),
-                                             fixed ? fixed->data() : nullptr, nF, inv.data(), tb.nt);
+                                             fixed ? fixed->data() : nullptr, nF, Aloc.data(), tb.nt);
                 M.resize((size_t)nE * 5);
-                hhj::assemble_ell(inv.data(), FE.data(), EF.data(), ELI.data(), nE, nullptr, M.data(), tb.nt);
+                hhj::assemble_ell(Aloc.data(), FE.data(), EF.data(), ELI.data(), nE, nullptr, M.data(), tb.nt);
             }
         }
         const size_t ne = nE;
         nb::object Mout = nb::none();
         if (schwarz) Mout = nb::cast(to_numpy(std::move(M), {ne, 5}));
         return nb::make_tuple(to_numpy(std::move(cols), {ne, 5}), to_numpy(std::move(A), {ne, 5}),
-                              Mout, n_jacobi);
+                              Mout, n_jacobi, to_numpy(std::move(sin_min), {(size_t)nF}));
     }, "V"_a, "F"_a, "FE"_a, "EF"_a, "ELI"_a, "fixed"_a.none(), "schwarz"_a);
 
     m.def("jump_apply", [](In<double> V, In<i64> F, In<i64> EF, In<i64> ELI, In<double> W) {
@@ -131,7 +132,8 @@ NB_MODULE(_hhj_core, m) {
 
     m.def("block_pcg", [](In<i64> Ap, In<std::int32_t> Ai, In<double> Ax, std::optional<In<i64>> Mp,
                           std::optional<In<std::int32_t>> Mi, std::optional<In<double>> Mx,
-                          std::optional<In<double>> dinv, In<double> R, double rtol, i64 maxiter,
+                          std::optional<In<double>> dinv, nb::ndarray<double, nb::c_contig, nb::device::cpu> R,
+                          double rtol, i64 maxiter,
                           i64 probe_iter, double max_predicted, std::optional<In<i64>> S,
                           std::optional<nb::callable> subdomain_solve) {
         need(R.ndim() == 2, "block_pcg: R must be (n, k)");

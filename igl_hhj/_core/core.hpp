@@ -95,7 +95,7 @@ void topology(const i64* F, i64 nF, i64 nV, Topology& out);
 void edge_morton_order(const double* V, i64 nV, const i64* E, i64 nE, i64* perm);
 
 // hhj_kernels.cpp
-void local_mass(const double* V, const i64* F, i64 nF, double* Aloc);
+void local_mass(const double* V, const i64* F, i64 nF, double* Aloc, double* sin_min = nullptr);
 void assemble_ell(const double* Aloc, const i64* FE, const i64* EF, const i64* ELI, i64 nE,
                   std::int32_t* cols, double* vals, int nt);
 i64 face_schwarz(const double* Aloc, const double* diag, const i64* FE, const unsigned char* fixed,
@@ -126,7 +126,7 @@ struct SubdomainSolve {
 };
 PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const double* Ax,
                     const i64* Mp, const std::int32_t* Mi, const double* Mx, const double* dinv,
-                    const double* R, double* X, double rtol, i64 maxiter,
+                    double* R, double* X, double rtol, i64 maxiter,
                     i64 probe_iter, double max_predicted, int nt,
                     const SubdomainSolve* sub = nullptr);
 

@@ -3,6 +3,8 @@
 // preconditioner, the jump operator B, S_h per face, the lumped vertex
 // recovery and the closed-form 2x2 eigen-problem.  Loops over faces or edges
 // write disjoint outputs (no atomics): results are independent of threads.
+#include <algorithm>
+
 #include "core.hpp"
 
 namespace hhj {
@@ -23,7 +25,8 @@ inline void basis_tensor(const FaceGeom& g, int j, double phi[3][3]) {
 
 // local_mass: Aloc[f] (3x3) = |T| phi_i : phi_j (eq. 5.14), closed form:
 // sym(a(x)b):sym(c(x)d) = ((a.c)(b.d) + (a.d)(b.c)) / 2 with the Gram matrix of the t_i.
-void local_mass(const double* V, const i64* F, i64 nF, double* Aloc) {
+// Also sin_min[f] = sine of the smallest angle, 2|T| l_min / (l_0 l_1 l_2) (may be nullptr).
+void local_mass(const double* V, const i64* F, i64 nF, double* Aloc, double* sin_min) {
     ThreadBudget tb(nF);
 #ifdef IGL_HHJ_OPENMP
 #pragma omp parallel for schedule(static) num_threads(tb.nt)
@@ -36,6 +39,8 @@ void local_mass(const double* V, const i64* F, i64 nF, double* Aloc) {
             for (int q = 0; q < 3; ++q) G[p][q] = dot3(g.t[p], g.t[q]);
         for (int j = 0; j < 3; ++j) den[j] = basis_denominator(g, j);
         const double area = 0.5 * g.dbl;
+        if (sin_min)
+            sin_min[f] = g.dbl * std::min(g.l[0], std::min(g.l[1], g.l[2])) / (g.l[0] * g.l[1] * g.l[2]);
         double* A = Aloc + 9 * f;
         for (int i = 0; i < 3; ++i) {
             const int ai = (i + 1) % 3, bi = (i + 2) % 3;
@@ -89,7 +94,7 @@ void assemble_ell(const double* blk, const i64* FE, const i64* EF, const i64* EL
 // diagonal (C = D blk D) by Cholesky pivots; a face whose scaled block is
 // numerically singular (pivot < 1e-8: near-degenerate triangle) gets the Jacobi
 // block diag(1/blk_ii) instead, so M stays SPD for every accepted mesh.
-// Returns the number of such faces.
+// Returns the number of such faces.  inv may alias Aloc (each face reads its block first).
 i64 face_schwarz(const double* Aloc, const double* diag, const i64* FE, const unsigned char* fixed,
                  i64 nF, double* inv, int nt) {
     i64 n_jacobi = 0;

@@ -101,7 +101,8 @@ void update(i64 n, int k, const double* alpha, double* X, double* r, const doubl
 }
 }  // namespace
 
-// block_pcg: solve A X = R, A (n x n) SPD in CSR (Ap, Ai, Ax), R and X (n, k) row-major,
+// block_pcg: solve A X = R, A (n x n) SPD in CSR (Ap, Ai, Ax), R and X (n, k) row-major
+// (R is overwritten by the final residual),
 // preconditioner M in CSR (Mp, Mi, Mx) or, with Mp == nullptr, Jacobi dinv (n,).
 // Column j stops when |r_j| <= rtol |R_j|.  Every probe_iter iterations (0: never) the
 // iterations still needed are extrapolated from the mean rate so far; above
@@ -109,12 +110,13 @@ void update(i64 n, int k, const double* alpha, double* X, double* r, const doubl
 // Status 3: breakdown (p.Ap <= 0 or the residual grew 1e4-fold: A numerically singular).
 PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const double* Ax,
                     const i64* Mp, const std::int32_t* Mi, const double* Mx, const double* dinv,
-                    const double* R, double* X, double rtol, i64 maxiter,
+                    double* R, double* X, double rtol, i64 maxiter,
                     i64 probe_iter, double max_predicted, int nt, const SubdomainSolve* sub) {
     if (k > 16) throw std::invalid_argument("block_pcg: at most 16 right-hand sides per call");
     PCGResult res;
     res.relres.assign(k, 0.0);
-    std::vector<double> r(R, R + (size_t)n * k), z((size_t)n * k), p((size_t)n * k), q((size_t)n * k);
+    double* r = R;  // R becomes the residual (caller's scratch: no copy of n x k)
+    std::vector<double> z((size_t)n * k), p((size_t)n * k), q((size_t)n * k);
     std::fill(X, X + (size_t)n * k, 0.0);
     Partials P(n, k);
     std::vector<double> bb(k), rr(k), rz(k), rz_new(k), pq(k), alpha(k), beta(k), tol2(k);
@@ -147,7 +149,7 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
     // z = M r (+ R_S^T C R_S r), out = r.z; the second level's share of r.z is summed
     // serially over S in a fixed order (deterministic).
     auto precondition = [&](std::vector<double>& out) {
-        apply_and_dot(n, k, Mp, Mi, Mx, dinv, r.data(), z.data(), r.data(), P, nt);
+        apply_and_dot(n, k, Mp, Mi, Mx, dinv, r, z.data(), r, P, nt);
         P.reduce(out);
         if (rS.empty()) return;
         for (i64 i = 0; i < sub->nS; ++i)
@@ -172,7 +174,7 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
             breakdown = breakdown || (active[j] && !(pq[j] > 0.0 && std::isfinite(alpha[j])));
         }
         if (breakdown) { res.status = 3; res.iterations = it; break; }
-        update(n, k, alpha.data(), X, r.data(), p.data(), q.data(), P, nt);
+        update(n, k, alpha.data(), X, r, p.data(), q.data(), P, nt);
         P.reduce(rr);
         res.iterations = it;
         any = false;
