@@ -16,7 +16,8 @@ For each mesh it prints: the smallest angle; the best-of-``--repeat`` wall time 
 ``igl_hhj.shape_operator`` with ``solver="direct"``, ``"cg"`` and ``"auto"`` (auto must
 never be slower than both); what "auto" chose and its PCG iterations; the peak memory of
 one drop-in call above the input (KB per face, in a fresh subprocess after a warm-up call
-on a tiny mesh: ``ru_maxrss`` minus the resident size before the call) and how much slower
+on a tiny mesh: the peak resident size ``VmHWM``, reset just before the call, minus the
+resident size before it) and how much slower
 the first call in a fresh process is than the best later one.  Writes ``speed.md`` to
 ``--out``.
 """
@@ -136,18 +137,25 @@ for _ in range(int(sys.argv[2])):
 print(json.dumps({"import": t_import, "first": first, "later": later}))
 """
 
+# Peak RSS from /proc/self/status VmHWM, reset to the current RSS just before the call
+# (writing 5 to /proc/self/clear_refs); ru_maxrss would include the parent's RSS at fork.
 _CHILD_MEMORY = r"""
-import json, resource, sys
+import json, sys
 import numpy as np
 import igl_hhj
 from igl_hhj.surfaces import icosphere
 igl_hhj.principal_curvature(*icosphere(2))        # imports and one-time set-up
 d = np.load(sys.argv[1]); V, F = d["V"], d["F"]
-with open("/proc/self/statm") as fh:
-    base = int(fh.read().split()[1]) * resource.getpagesize()
+def status(key):
+    with open("/proc/self/status") as fh:
+        for line in fh:
+            if line.startswith(key):
+                return int(line.split()[1]) * 1024
+base = status("VmRSS:")
+with open("/proc/self/clear_refs", "w") as fh:
+    fh.write("5")
 igl_hhj.principal_curvature(V, F)
-peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-print(json.dumps({"peak": peak - base}))
+print(json.dumps({"peak": status("VmHWM:") - base}))
 """
 
 
