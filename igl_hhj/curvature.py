@@ -99,16 +99,16 @@ def _simply_supported_values(mesh, boundary_shape_operator, ss_edges):
     return rho
 
 
-def _boundary_rhs(mesh, rhs, clamped, boundary_normals):
+def _boundary_rhs(mesh, rhs, clamped, N):
     """Boundary rows of ``-B X + g`` in place: plain assembly on boundary edges without
     data (``g_e = l_e n·∇_T X`` cancels B's one-sided term, so the row is 0) and
-    Walker's clamped load (eq. 5.19's Σ_c term) on the clamped ones."""
+    Walker's clamped load (eq. 5.19's Σ_c term) on the clamped ones, with the
+    normalised boundary normals ``N`` (#V, 3)."""
     bnd = mesh.boundary_edges
     if not bnd.any():
         return rhs
     rhs[bnd & ~clamped] = 0.0
     if clamped.any():
-        N = _normalised_boundary_normals(mesh, boundary_normals, clamped)
         # ξ^k = ∇_Γ id^k = P e_k, P = I - ν~ ⊗ ν~: gradients of the 3 coordinates.
         P = np.eye(3)[None] - N[:, :, None] * N[:, None, :]   # (#V, 3, 3): row k = ξ^k
         P[~np.isfinite(P)] = 0.0
@@ -121,15 +121,14 @@ def _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supp
     """Compiled path of :func:`shape_operator` (reference: :func:`_shape_operator_reference`)."""
     clamped, ss_edges = _boundary_partition(mesh, boundary_normals, boundary_shape_operator,
                                             simply_supported)
-    if clamped.any():                                         # check the data before the work
-        _normalised_boundary_normals(mesh, boundary_normals, clamped)
+    N = _normalised_boundary_normals(mesh, boundary_normals, clamped) if clamped.any() else None
     fixed = ss_edges if ss_edges.any() else None
     if fixed is not None:
         rho = _simply_supported_values(mesh, boundary_shape_operator, ss_edges)
     system = HHJSystem(mesh, fixed=fixed)
     rhs = kernels.jump_apply(mesh, mesh.V)                    # B X, (#E, 3)
     np.negative(rhs, out=rhs)                                 # -B X
-    _boundary_rhs(mesh, rhs, clamped, boundary_normals)
+    _boundary_rhs(mesh, rhs, clamped, N)
     if fixed is not None:                                     # eq. 5.18/5.19: move ρ to the load
         rhs -= system.fixed_coupling(rho)
         rhs[fixed] = 0.0
@@ -202,7 +201,7 @@ def shape_operator(V, F, *, boundary_normals=None, boundary_shape_operator=None,
     solver : {"auto", "cg", "direct"}
         Linear solver for A (strategy in :mod:`igl_hhj.solvers`): "auto" picks
         sparse Cholesky or the compiled face-Schwarz PCG by measured cost.
-    rtol : float, default :data:`igl_hhj.solvers.DEFAULT_RTOL` (1e-8)
+    rtol : float, default :data:`igl_hhj.solvers.DEFAULT_RTOL` (1e-6)
         Relative residual of the iterative solve, per coordinate right-hand
         side; the default leaves a solver error far below the O(h)
         discretisation error (see :mod:`igl_hhj.solvers`).

@@ -5,22 +5,27 @@ Three ways to solve, chosen per call:
 * ``"direct"``: sparse Cholesky (CHOLMOD through ``cholespy``; SuperLU when
   cholespy is not importable), one factorisation for all right-hand sides.
 * ``"cg"``: the compiled fused block PCG (:func:`igl_hhj.kernels.block_pcg`),
-  preconditioned by the face-Schwarz preconditioner (exact inverses of every
-  face's 3×3 block of A).
-* ``"auto"`` (default): direct for small systems; otherwise PCG that checks
-  its convergence rate every :data:`PROBE_ITER` iterations and, when the
-  extrapolated iteration count would cost more than the estimated direct
-  solve, stops and factorises instead (sliver meshes).  Above
-  :data:`DIRECT_MAX` unknowns (memory) PCG always runs to the end.
+  preconditioned by a two-level method: the face-Schwarz preconditioner (exact
+  inverses of every face's 3×3 block of A) plus an exact sparse Cholesky solve on
+  the DOFs of the faces with a smallest angle below :data:`SLIVER_ANGLE` (where
+  A's ill-conditioning lives).  Without the second level, sliver meshes need
+  400–800 iterations (camelhead 811, bunny upsampled twice 417); with it 40–60.
+* ``"auto"`` (default): direct below :data:`AUTO_DIRECT_MAX` unknowns; otherwise
+  the same PCG, which checks its convergence rate every :data:`PROBE_ITER`
+  iterations and, when the extrapolated iteration count would cost more than the
+  estimated factorisation (:func:`_direct_seconds`), stops and factorises instead.
+  Above :data:`DIRECT_MAX` unknowns (memory) PCG always runs to the end.
 
 Tolerance
 ---------
 ``rtol`` is the relative residual ``‖r_j‖ ≤ rtol ‖R_j‖`` per right-hand side.
-The default :data:`DEFAULT_RTOL` = 1e-8 for the public curvature functions is
-tied to the discretisation error: the method's error is O(h) (≥ 1e-4 relative
-on every mesh up to millions of faces), and the solver error this tolerance
-leaves in the vertex curvatures is below 1e-4 of it (measured by
-``python -m igl_hhj.benchmarks.speed --rtol-study``; see README "Speed").
+The default :data:`DEFAULT_RTOL` = 1e-6 of the public curvature functions is tied to
+the discretisation error: ``python -m igl_hhj.benchmarks.speed --rtol-study`` measures
+the L2 vertex error of H against the exact surface on jittered ellipsoids (20k–328k
+faces) and Walker's sliver torus; at 1e-6 it differs from the error at 1e-12 by at
+most 0.0004 % (1e-4: up to 0.03 %, growing about 4× per refinement; 1e-3: 3.6 % at
+328k faces), for 35–50 % fewer iterations than 1e-12.  :func:`igl_hhj.hhj.solve_spd`
+keeps its own default 1e-10 (generic systems).
 """
 from __future__ import annotations
 
@@ -34,7 +39,7 @@ from .errors import SolverDidNotConverge, SolverError
 
 __all__ = ["DEFAULT_RTOL", "HHJSystem", "cholesky_solve", "pcg", "SolveInfo"]
 
-DEFAULT_RTOL = 1e-8
+DEFAULT_RTOL = 1e-6
 # "auto": factorise without trying PCG up to this many unknowns (everything is instant there)
 AUTO_DIRECT_MAX = 3_000
 # "auto": never factorise above this many unknowns (fill and memory), PCG runs to convergence
@@ -44,10 +49,9 @@ PROBE_ITER = 20
 # iteration cap of "cg"
 CG_MAXITER = 5000
 # faces with a smallest angle below this (degrees) form the sliver subdomain of the
-# two-level preconditioner (exact sparse solve on their DOFs).  Measured (CPU s / PCG its
-# at 5°, 10°, 15°, 20°, 25°): camelhead .16/210 .10/113 .08/69 .07/49 .10/38; bunny
-# upsampled twice 1.20/247 .72/143 .40/93 .36/61 .33/45; open scan 0.02° .65/366 .50/195
-# .36/115 .28/68 .43/50; jittered ellipsoid 328k 2.1/87 1.6/69 1.5/66 1.8/52 2.1/42.
+# two-level preconditioner (exact sparse solve on their DOFs); chosen by
+# `python -m igl_hhj.benchmarks.speed --sliver-study` (0°-25° on camelhead, the bunny
+# upsampled twice, an open scan and a jittered ellipsoid: 15-20° is fastest on all four)
 SLIVER_ANGLE = 20.0
 # above this fraction of sliver DOFs the mesh is "all slivers": "auto" factorises A itself
 SLIVER_MAX_FRACTION = 0.8
@@ -60,14 +64,16 @@ class SolveInfo(dict):
 def _direct_seconds(n):
     """Estimated time of one sparse Cholesky factorisation + solve of the HHJ matrix (n unknowns).
 
-    Power-law fit of CHOLMOD times measured on this machine (single core): 0.19 s at
-    34k unknowns (camelhead), 1.4 s at 167k (bunny upsampled twice)."""
+    Power-law fit of CHOLMOD times on this machine (single core; the "S_h direct"
+    column of ``python -m igl_hhj.benchmarks.speed``): ≈ 0.2 s at 34k unknowns
+    (camelhead), ≈ 1.4 s at 167k (bunny upsampled twice)."""
     return 3.9e-7 * n ** 1.255
 
 
 def _pcg_iter_seconds(n, k):
     """Estimated time of one fused PCG iteration (n unknowns, k right-hand sides);
-    measured 23 ms at 491k unknowns, k = 3, single core."""
+    ≈ 0.1 s for 7 iterations at 1.97M unknowns, k = 3, single core
+    (``python -m igl_hhj.benchmarks.speed --profile 'icosphere(8)'``: PCG 0.71 s)."""
     return 1.2e-8 * n * (1 + k)
 
 

@@ -2,7 +2,7 @@
 measured in the same run.
 
     python -m igl_hhj.benchmarks.speed [--quick] [--repeat 3] [--meshes DIR] [--out DIR]
-    python -m igl_hhj.benchmarks.speed --rtol-study
+    python -m igl_hhj.benchmarks.speed --rtol-study | --sliver-study | --profile 'icosphere(8)'
 
 Meshes: icosphere(7) (328k faces) and icosphere(8) (1.31M), a jittered ellipsoid at
 82k / 328k / 1.31M faces (linear-scaling check), Walker's torus from a perturbed grid
@@ -265,6 +265,67 @@ def rtol_markdown(rows):
     return "\n".join(lines)
 
 
+SLIVER_ANGLES = (0, 5, 10, 15, 20, 25)
+SLIVER_MESHES = ("camelhead.off", "bunny upsampled ×2", "open scan-like height field", "jittered ellipsoid")
+
+
+def sliver_study(angles=SLIVER_ANGLES, mesh_dir=None, rtol=1e-8):
+    """PCG iterations and CPU time of the compiled solve against the sliver threshold
+    of the two-level preconditioner (0 = face-Schwarz alone), single thread."""
+    from igl_hhj import kernels, solvers
+    from igl_hhj.mesh import TriangleMesh
+    mesh_dir = _default_mesh_dir() if mesh_dir is None else Path(mesh_dir)
+    meshes = [m for n in ("real", "bunny upsampled ×2", "open scan 51k", "ellipsoid 328k")
+              for m in _build(n, mesh_dir) if m[0] in SLIVER_MESHES]
+    old, threads = solvers.SLIVER_ANGLE, kernels.max_threads()
+    rows = []
+    try:
+        kernels.set_num_threads(1)
+        for label, V, F in meshes:
+            m = TriangleMesh(V, F)
+            rhs = -kernels.jump_apply(m, m.V)
+            system = solvers.HHJSystem(m)
+            for a in angles:
+                solvers.SLIVER_ANGLE = a
+                t = time.process_time()
+                _, info = system.solve(rhs, "cg", rtol)
+                rows.append({"mesh": label, "faces": len(F), "angle": a, "seconds": time.process_time() - t,
+                             "iterations": info["iterations"],
+                             "fraction": info.get("sliver_dofs", 0) / system.n})
+    finally:
+        solvers.SLIVER_ANGLE = old
+        kernels.set_num_threads(threads)
+    return rows
+
+
+def profile_stages(V, F, rtol=None):
+    """CPU seconds (single thread) of the drop-in's stages on one mesh."""
+    from igl_hhj import kernels, solvers
+    from igl_hhj.mesh import TriangleMesh
+    threads = kernels.max_threads()
+    kernels.set_num_threads(1)
+    out = {}
+
+    def stage(name, fn):
+        t = time.process_time()
+        r = fn()
+        out[name] = time.process_time() - t
+        return r
+    try:
+        m = stage("validation + topology", lambda: (TriangleMesh(V, F), None)[0])
+        system = stage("HHJ assembly + preconditioner", lambda: solvers.HHJSystem(m))
+        rhs = stage("load -B X", lambda: -kernels.jump_apply(m, m.V))
+        s, info = stage("PCG", lambda: system.solve(rhs, "cg", rtol or solvers.DEFAULT_RTOL))
+        S = stage("S_h", lambda: kernels.shape_operator_faces(m, s))
+        N = stage("vertex normals", lambda: m.vertex_normals)
+        Sv = stage("recovery", lambda: kernels.lumped_vertex_recovery(m, S, N))
+        stage("2x2 eigen", lambda: kernels.principal_2x2(Sv, N))
+        out["PCG iterations"] = info["iterations"]
+    finally:
+        kernels.set_num_threads(threads)
+    return out
+
+
 def markdown(rows):
     head = ["mesh", "faces", "min angle", "libigl (s)", "drop-in (s)", "ratio", "µs/face",
             "S_h direct (s)", "S_h cg (s)", "S_h auto (s)", "auto chose", "PCG its",
@@ -289,9 +350,25 @@ def main(argv=None):
     p.add_argument("--meshes", default=None, help="folder of real meshes (default ../shared/data/meshes)")
     p.add_argument("--no-memory", action="store_true", help="skip the fresh-process memory column")
     p.add_argument("--out", default="benchmark-results")
+    p.add_argument("--sliver-study", action="store_true",
+                   help="only PCG iterations / CPU time against the sliver threshold")
+    p.add_argument("--profile", default=None, metavar="MESH",
+                   help="only the CPU time of each stage on one mesh, e.g. 'icosphere(8)'")
     p.add_argument("--rtol-study", action="store_true",
                    help="only the tolerance study (PCG iterations and error vs rtol)")
     a = p.parse_args(argv)
+    if a.sliver_study:
+        rows = sliver_study(mesh_dir=a.meshes)
+        lines = ["| mesh | faces | sliver angle | sliver DOFs | PCG its | CPU s |", "|---|---|---|---|---|---|"]
+        lines += [f"| {r['mesh']} | {r['faces']:,} | {r['angle']}° | {100 * r['fraction']:.0f} % | "
+                  f"{r['iterations']} | {r['seconds']:.3f} |" for r in rows]
+        print("\n".join(lines))
+        return
+    if a.profile:
+        V, F = _build(a.profile, None)[0][1:]
+        for k, v in profile_stages(V, F).items():
+            print(f"{k}: {v:.3f}" if isinstance(v, float) else f"{k}: {v}")
+        return
     if a.rtol_study:
         table = rtol_markdown(rtol_study())
         print(table)
