@@ -18,6 +18,12 @@ biharmonic solver, also as :func:`biharmonic_solve`), :mod:`igl_hhj.baselines`
 :mod:`igl_hhj.cli` (the ``igl-hhj`` command).
 """
 import importlib
+import pkgutil
+
+# Run from a source checkout (e.g. `python -m pytest` in the repository, whose folder
+# shadows the installed package), the compiled core igl_hhj._hhj_core lives only in the
+# installed copy: let the package's submodule search fall through to it.
+__path__ = pkgutil.extend_path(__path__, __name__)
 
 from .curvature import (
     face_gaussian_curvature,
