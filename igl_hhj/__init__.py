@@ -21,6 +21,12 @@ biharmonic solver, also as :func:`biharmonic_solve`), :mod:`igl_hhj.baselines`
 smoothing scale of the drop-in), :mod:`igl_hhj.boundary_estimation` (data-free boundary normals).
 """
 import importlib
+import pkgutil
+
+# Run from a source checkout (e.g. `python -m pytest` in the repository, whose folder
+# shadows the installed package), the compiled core igl_hhj._hhj_core lives only in the
+# installed copy: let the package's submodule search fall through to it.
+__path__ = pkgutil.extend_path(__path__, __name__)
 
 __version__ = "0.1.0"
 

@@ -12,10 +12,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .hhj import HHJProjection, clamped_load, face_tensors
-from .mesh import TriangleMesh, as_mesh, mark_bad_vertices, per_vertex_array
+from . import kernels
 from . import recovery as _recovery
 from .boundary_estimation import BOUNDARY_TREATMENTS, estimate_boundary_normals
+from .hhj import HHJProjection, clamped_load
+from .mesh import TriangleMesh, as_mesh, mark_bad_vertices, per_vertex_array
+from .solvers import DEFAULT_RTOL, HHJSystem
 
 __all__ = [
     "shape_operator", "surface_hessian", "principal_curvature",
@@ -157,8 +159,54 @@ def _simply_supported_values(mesh, boundary_shape_operator, ss_edges):
     return rho
 
 
+def _boundary_rhs(mesh, rhs, clamped, N):
+    """Boundary rows of ``-B X + g`` in place: plain assembly on boundary edges without
+    data (``g_e = l_e n·∇_T X`` cancels B's one-sided term, so the row is 0) and
+    Walker's clamped load (eq. 5.19's Σ_c term) on the clamped ones, with the
+    normalised boundary normals ``N`` (#V, 3)."""
+    bnd = mesh.boundary_edges
+    if not bnd.any():
+        return rhs
+    rhs[bnd & ~clamped] = 0.0
+    if clamped.any():
+        # ξ^k = ∇_Γ id^k = P e_k, P = I - ν~ ⊗ ν~: gradients of the 3 coordinates.
+        P = np.eye(3)[None] - N[:, :, None] * N[:, None, :]   # (#V, 3, 3): row k = ξ^k
+        P[~np.isfinite(P)] = 0.0
+        rhs[clamped] += clamped_load(mesh, clamped, P)[clamped]
+    return rhs
+
+
 def _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver,
-                    estimated=False):
+                    rtol=DEFAULT_RTOL, info=None, estimated=False):
+    """Compiled path of :func:`shape_operator` (reference: :func:`_shape_operator_reference`).
+
+    ``estimated``: ``boundary_normals`` come from :func:`estimate_boundary_normals`
+    (see :func:`_boundary_partition`)."""
+    clamped, ss_edges = _boundary_partition(mesh, boundary_normals, boundary_shape_operator,
+                                            simply_supported, estimated)
+    N = _normalised_boundary_normals(mesh, boundary_normals, clamped) if clamped.any() else None
+    fixed = ss_edges if ss_edges.any() else None
+    if fixed is not None:
+        rho = _simply_supported_values(mesh, boundary_shape_operator, ss_edges)
+    system = HHJSystem(mesh, fixed=fixed)
+    rhs = kernels.jump_apply(mesh, mesh.V)                    # B X, (#E, 3)
+    np.negative(rhs, out=rhs)                                 # -B X
+    _boundary_rhs(mesh, rhs, clamped, N)
+    if fixed is not None:                                     # eq. 5.18/5.19: move ρ to the load
+        rhs -= system.fixed_coupling(rho)
+        rhs[fixed] = 0.0
+    s, solve_info = system.solve(rhs, solver, rtol, overwrite_rhs=True)   # (#E, 3): σ^k DOFs
+    del rhs
+    if fixed is not None:
+        s[fixed] = rho[fixed]
+    if info is not None:
+        info.update(solve_info)
+    return kernels.shape_operator_faces(mesh, s)              # S_h|_T = -Σ_k ν_T^k σ^k|_T
+
+
+def _shape_operator_reference(mesh, boundary_normals=None, boundary_shape_operator=None,
+                              simply_supported=None, solver="direct", estimated=False):
+    """The readable numpy reference of :func:`_shape_operator` (:mod:`igl_hhj.hhj`)."""
     clamped, ss_edges = _boundary_partition(mesh, boundary_normals, boundary_shape_operator,
                                             simply_supported, estimated)
     proj = HHJProjection(mesh, fixed_edges=ss_edges, solver=solver)
@@ -166,24 +214,30 @@ def _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supp
     load = proj.plain_boundary_load(X)
     if clamped.any():
         N = _normalised_boundary_normals(mesh, boundary_normals, clamped)
-        # ξ^k = ∇_Γ id^k = P e_k, P = I - ν~ ⊗ ν~: gradients of the 3 coordinates.
-        P = np.eye(3)[None] - N[:, :, None] * N[:, None, :]   # (#V, 3, 3): row k = ξ^k
+        P = np.eye(3)[None] - N[:, :, None] * N[:, None, :]
         P[~np.isfinite(P)] = 0.0
         load[clamped] = clamped_load(mesh, clamped, P)[clamped]
     fixed_values = _simply_supported_values(mesh, boundary_shape_operator, ss_edges) \
         if ss_edges.any() else None
-    s = proj.solve(X, load=load, fixed_values=fixed_values)   # (#E, 3): σ^k DOFs
-    # S_h|_T = -Σ_k ν_T^k σ^k|_T: contract the DOFs with the face normal first.
+    s = proj.solve(X, load=load, fixed_values=fixed_values)
     c = -np.einsum("fjk,fk->fj", s[mesh.face_edges], mesh.face_normals)
-    S = np.einsum("fj,fjab->fab", c, proj.phi)
-    return S
+    return np.einsum("fj,fjab->fab", c, proj.phi)
+
+
+def _check_rtol(rtol):
+    if isinstance(rtol, (bool, np.bool_)) or not isinstance(rtol, (int, float, np.floating, np.integer)):
+        raise TypeError(f"rtol must be a float, got {type(rtol).__name__}")
+    rtol = float(rtol)
+    if not 0.0 < rtol < 1.0:
+        raise ValueError(f"rtol must be in (0, 1), got {rtol}")
+    return rtol
 
 
 # --------------------------------------------------------------------------- public API
 def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary: str = "estimate",
                    boundary_normals: ArrayLike | None = None,
                    boundary_shape_operator: ArrayLike | None = None, simply_supported: ArrayLike | None = None,
-                   solver: str = "auto") -> NDArray[np.float64]:
+                   solver: str = "auto", rtol: float = DEFAULT_RTOL) -> NDArray[np.float64]:
     """Walker's HHJ approximation S_h of the shape operator ∇_Γν, one tensor per face.
 
     Solves ``A s^k = -B X^k + g^k`` for the three coordinate functions
@@ -218,7 +272,12 @@ def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary: str = "estim
         With both data arrays: boundary edges whose two endpoints are flagged
         are simply supported, the other boundary edges clamped.
     solver : {"auto", "cg", "direct"}
-        Linear solver for A (see :func:`igl_hhj.hhj.solve_spd`).
+        Linear solver for A (strategy in :mod:`igl_hhj.solvers`): "auto" picks
+        sparse Cholesky or the compiled face-Schwarz PCG by measured cost.
+    rtol : float, default :data:`igl_hhj.solvers.DEFAULT_RTOL` (1e-6)
+        Relative residual of the iterative solve, per coordinate right-hand
+        side; the default leaves a solver error far below the O(h)
+        discretisation error (see :mod:`igl_hhj.solvers`).
 
     Returns
     -------
@@ -254,7 +313,7 @@ def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary: str = "estim
     boundary_normals, treatment = _resolve_boundary(mesh, boundary, boundary_normals,
                                                     boundary_shape_operator)
     S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver,
-                        estimated=treatment == "estimate")
+                        _check_rtol(rtol), estimated=treatment == "estimate")
     bad = ~np.isfinite(S).all(axis=(1, 2))
     if bad.any():                     # never silent NaN (issue 12)
         from .errors import SolverError
@@ -265,7 +324,7 @@ def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary: str = "estim
 
 
 def surface_hessian(V: Any, F: ArrayLike | None, w: ArrayLike, *, boundary_gradient: ArrayLike | None = None,
-                    solver: str = "auto") -> NDArray[np.float64]:
+                    solver: str = "auto", rtol: float = DEFAULT_RTOL) -> NDArray[np.float64]:
     """HHJ projection of the surface Hessian ∇_Γ∇_Γ w of a P1 function (Walker eq. 4.9).
 
     Parameters
@@ -303,18 +362,20 @@ def surface_hessian(V: Any, F: ArrayLike | None, w: ArrayLike, *, boundary_gradi
         raise ValueError(f"w has NaN or inf at vertex {int(np.flatnonzero(~np.isfinite(W).all(1) & ref)[0])}")
     W = np.where(np.isfinite(W), W, 0.0)
     _check_magnitude(W, np.arange(len(W)), "w")
-    proj = HHJProjection(mesh, solver=solver)
-    load = proj.plain_boundary_load(W)
+    rtol = _check_rtol(rtol)
+    rhs = -kernels.jump_apply(mesh, W)                        # -B w, (#E, k)
+    bnd = mesh.boundary_edges
     if boundary_gradient is not None and mesh.has_boundary:
         G = np.asarray(boundary_gradient)
         G = per_vertex_array(mesh, G, "boundary_gradient", (3,))[:, None, :] if single \
             else per_vertex_array(mesh, G, "boundary_gradient", (W.shape[1], 3))
-        bnd = mesh.boundary_edges
         _data_rows(mesh, G, bnd, "boundary_gradient")
         G = np.where(np.isfinite(G), G, 0.0)
-        load[bnd] = clamped_load(mesh, bnd, G)[bnd]
-    s = proj.solve(W, load=load)
-    H = face_tensors(mesh, s, proj.phi)
+        rhs[bnd] += clamped_load(mesh, bnd, G)[bnd]
+    else:
+        rhs[bnd] = 0.0                                        # plain assembly
+    s, _ = HHJSystem(mesh).solve(rhs, solver, rtol)
+    H = kernels.face_tensors(mesh, s)
     return H[:, 0] if single else H
 
 
@@ -332,7 +393,24 @@ def principal_from_shape_operator(S: NDArray[np.floating], normals: NDArray[np.f
     PD1, PD2 : (n, 3) unit principal directions (PD2 = normal × PD1).
     PV1, PV2 : (n,) principal curvatures, PV1 ≥ PV2: the eigenvalues of the
         tangential 2×2 block of S.
+
+    Notes
+    -----
+    Compiled closed-form 2×2 eigen-solve (:func:`igl_hhj.kernels.principal_2x2`)
+    in the tangent frame ``e1 = N × a / |N × a|`` (a the coordinate axis least
+    aligned with N), ``e2 = N × e1``; the numpy ``eigh`` reference is
+    :func:`_principal_from_shape_operator_reference`.  Where κ1 = κ2 the
+    direction is arbitrary (both implementations pick some unit tangent).
     """
+    S = np.asarray(S, dtype=np.float64)
+    N = np.asarray(normals, dtype=np.float64)
+    if S.ndim != 3 or S.shape[1:] != (3, 3) or N.shape != (S.shape[0], 3):
+        raise ValueError(f"S must be (n, 3, 3) and normals (n, 3), got {S.shape} and {N.shape}")
+    return kernels.principal_2x2(S, N)
+
+
+def _principal_from_shape_operator_reference(S, normals):
+    """The readable numpy reference of :func:`principal_from_shape_operator` (``eigh``)."""
     N = normals
     # Tangent frame: e1 ⟂ N from the coordinate axis least aligned with N.
     ax = np.eye(3)[np.argmin(np.abs(N), axis=1)]
@@ -479,11 +557,26 @@ def vertex_shape_operator(mesh, S, *, smoothing=0, recovery="patch"):
     return Sv, N
 
 
+def _vertex_shape_operator_reference(mesh, S):
+    """Numpy reference of the compiled lumped recovery :func:`igl_hhj.kernels.lumped_vertex_recovery`
+    (the area-weighted 1-ring average; ``recovery="lumped"`` of :func:`vertex_shape_operator`
+    uses sliver-aware weights instead)."""
+    N = mesh.vertex_normals
+    A = np.broadcast_to(mesh.face_areas[:, None], (mesh.n_faces, 3))
+    acc = mesh.sum_corners_to_vertices(A[:, :, None, None] * S[:, None])
+    wsum = mesh.sum_corners_to_vertices(A)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        Sv = acc / wsum[:, None, None]
+    P = np.eye(3)[None] - N[:, :, None] * N[:, None, :]
+    Sv = P @ Sv @ P
+    return Sv, N
+
+
 def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, useKring: bool = True, *,
                         boundary: str = "estimate",
                         boundary_normals: ArrayLike | None = None, boundary_shape_operator: ArrayLike | None = None,
-                        simply_supported: ArrayLike | None = None, solver: str = "auto"
-                        ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
+                        simply_supported: ArrayLike | None = None, solver: str = "auto",
+                        rtol: float = DEFAULT_RTOL) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
                                    list[int]]:
     """Drop-in replacement for ``igl.principal_curvature`` (libigl ≥ 2.5.4 / 2.6).
 
@@ -513,7 +606,7 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
         Open meshes without boundary data: clamped with estimated O(h²) normals
         (converges up to the boundary) or the plain assembly (see
         :func:`shape_operator`).
-    boundary_normals, boundary_shape_operator, simply_supported, solver
+    boundary_normals, boundary_shape_operator, simply_supported, solver, rtol
         Keyword-only extras, see :func:`shape_operator`.
 
     Returns
@@ -544,7 +637,7 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
     boundary_normals, treatment = _resolve_boundary(mesh, boundary, boundary_normals,
                                                     boundary_shape_operator)
     S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver,
-                        estimated=treatment == "estimate")
+                        _check_rtol(rtol), estimated=treatment == "estimate")
     Sv, N = vertex_shape_operator(mesh, S, smoothing=radius)
     PD1, PD2, PV1, PV2 = vertex_principal_curvature(mesh, Sv, N)
     PD1, PD2, PV1, PV2, bad = mark_bad_vertices(mesh, PD1, PD2, PV1, PV2)

@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from .errors import SolverDidNotConverge
 from .mesh import TriangleMesh
@@ -163,32 +162,6 @@ def clamped_load(mesh: TriangleMesh, edge_mask, gradient):
     return g
 
 
-def _guarded_block_inverse(blk):
-    """Inverses of the (#F, 3, 3) face blocks; a block that is singular in float64
-    (a sliver at the validation threshold) gets its Jacobi inverse instead, so
-    the preconditioner stays SPD instead of raising ``LinAlgError``.
-    (Minimal guard added by the "rel" helper, issue 12.)"""
-    try:
-        return np.linalg.inv(blk)
-    except np.linalg.LinAlgError:
-        pass
-    d = np.einsum("fii->fi", blk)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        jac = np.where(d > 0, 1.0 / d, 0.0)
-    inv = np.zeros_like(blk)
-    idx = np.arange(3)
-    inv[:, idx, idx] = jac
-    det = np.linalg.det(blk)
-    scale = np.prod(np.abs(d), axis=1)
-    ok = np.isfinite(det) & (np.abs(det) > 1e-14 * scale)
-    if ok.any():
-        try:
-            inv[ok] = np.linalg.inv(blk[ok])
-        except np.linalg.LinAlgError:
-            pass
-    return inv
-
-
 def face_schwarz_preconditioner(mesh: TriangleMesh, A, phi=None, free=None):
     """Additive Schwarz preconditioner over faces for the HHJ matrix A.
 
@@ -208,6 +181,12 @@ def face_schwarz_preconditioner(mesh: TriangleMesh, A, phi=None, free=None):
     Returns
     -------
     M : (#free, #free) scipy.sparse.csr_matrix
+
+    Notes
+    -----
+    Near-degenerate faces (accepted down to ``mesh.DEGENERATE_AREA_RTOL``) can make
+    a face block numerically singular; such a block is replaced by its
+    diagonal (:func:`_robust_block_inverse`), so this never raises.
     """
     if phi is None:
         phi = local_basis(mesh)
@@ -215,22 +194,56 @@ def face_schwarz_preconditioner(mesh: TriangleMesh, A, phi=None, free=None):
     blk = np.einsum("fiab,fjab->fij", phi, phi) * mesh.face_areas[:, None, None]
     idx = np.arange(3)
     blk[:, idx, idx] = A.diagonal()[FE]
+    fixed_loc = None
     if free is not None and not np.all(free):
         fixed_loc = ~free[FE]                              # (#F, 3)
         blk[fixed_loc[:, :, None] | fixed_loc[:, None, :]] = 0.0
         fl = np.flatnonzero(fixed_loc.ravel())
         blk.reshape(-1, 3)[fl, np.tile(idx, len(FE))[fl]] = 1.0
-        inv = _guarded_block_inverse(blk)
+    inv = _robust_block_inverse(blk)
+    if fixed_loc is not None:
         inv[fixed_loc[:, :, None] | fixed_loc[:, None, :]] = 0.0
         new_index = np.cumsum(free) - 1
         FE = np.where(free[FE], new_index[FE], 0)
         n = int(free.sum())
     else:
-        inv = _guarded_block_inverse(blk)
         n = mesh.n_edges
     rows = np.broadcast_to(FE[:, :, None], inv.shape)
     cols = np.broadcast_to(FE[:, None, :], inv.shape)
     return _assemble(rows, cols, inv, (n, n))
+
+
+# A face block whose unit-diagonal scaling has a Cholesky pivot below this is
+# treated as numerically singular (a near-degenerate triangle).
+SCHWARZ_PIVOT_MIN = 1e-8
+
+
+def _robust_block_inverse(blk):
+    """Inverses of SPD 3×3 blocks (#F, 3, 3), robust to near-singular ones.
+
+    Each block is scaled to unit diagonal, ``C = D blk D`` with
+    ``D = diag(blk)^-1/2``; where a Cholesky pivot of C (``1 - c01²`` or
+    ``1 - c02² - l21²``) is below :data:`SCHWARZ_PIVOT_MIN` the block is replaced
+    by its diagonal (Jacobi on that face), so the sum over faces stays SPD.  The
+    compiled twin is ``face_schwarz`` in ``igl_hhj/_core/hhj_kernels.cpp``."""
+    d = 1.0 / np.sqrt(np.einsum("fii->fi", blk))
+    C = blk * d[:, :, None] * d[:, None, :]
+    c01, c02, c12 = C[:, 0, 1], C[:, 0, 2], C[:, 1, 2]
+    p2 = 1.0 - c01 ** 2
+    l21 = np.where(p2 > 0, (c12 - c02 * c01) / np.sqrt(np.where(p2 > 0, p2, 1.0)), 0.0)
+    p3 = 1.0 - c02 ** 2 - l21 ** 2
+    ok = (p2 >= SCHWARZ_PIVOT_MIN) & (p3 >= SCHWARZ_PIVOT_MIN)
+    det = np.where(ok, p2 * p3, 1.0)
+    ci = np.empty_like(C)
+    ci[:, 0, 0] = 1.0 - c12 ** 2
+    ci[:, 1, 1] = 1.0 - c02 ** 2
+    ci[:, 2, 2] = p2
+    ci[:, 0, 1] = ci[:, 1, 0] = c02 * c12 - c01
+    ci[:, 0, 2] = ci[:, 2, 0] = c01 * c12 - c02
+    ci[:, 1, 2] = ci[:, 2, 1] = c01 * c02 - c12
+    ci /= det[:, None, None]
+    ci[~ok] = np.eye(3)
+    return ci * d[:, :, None] * d[:, None, :]
 
 
 def solve_spd(A, R, *, method="auto", rtol=1e-10, maxiter=None, preconditioner=None):
@@ -241,26 +254,32 @@ def solve_spd(A, R, *, method="auto", rtol=1e-10, maxiter=None, preconditioner=N
     A : (n, n) scipy.sparse SPD matrix
     R : (n,) or (n, k) right-hand sides
     method : {"auto", "cg", "direct"}
-        "cg": preconditioned conjugate gradients, vectorised over the k
-        columns (one sparse mat-mat product per iteration), preconditioned by
-        ``preconditioner`` (a sparse SPD approximation of A⁻¹, e.g.
-        :func:`face_schwarz_preconditioner`) or, without one, Jacobi.
-        "direct": sparse LU (``scipy.sparse.linalg.splu``).
+        "cg": the compiled fused block PCG (:func:`igl_hhj.kernels.block_pcg`)
+        over the k columns, preconditioned by ``preconditioner`` (a sparse SPD
+        approximation of A⁻¹, e.g. :func:`face_schwarz_preconditioner`) or,
+        without one, Jacobi.
+        "direct": sparse Cholesky (:func:`igl_hhj.solvers.cholesky_solve`:
+        CHOLMOD via cholespy, SuperLU if absent).
         "auto": direct up to ``AUTO_DIRECT_MAX`` (50 000) unknowns; above,
-        PCG, falling back to the direct solver if it has not converged after
-        ``maxiter`` (default ``AUTO_CG_MAXITER`` = 600) iterations.
+        PCG, switching to the direct solver as soon as the measured
+        convergence rate predicts more than ``maxiter`` (default
+        ``AUTO_CG_MAXITER`` = 600) iterations (checked every 20 iterations).
     rtol : float
         CG stops when ``‖r_j‖ ≤ rtol ‖R_j‖`` for every column j.  The default
         1e-10 leaves a solver error far below every discretisation error in
         the convergence tables (tests compare CG with the direct solve).
     maxiter : int, optional
         CG iteration cap (default 2000 for "cg", 600 for "auto").
+    preconditioner : (n, n) scipy.sparse matrix, optional
+        Applied as ``z = M r``.  Anything else with ``@`` (e.g. a
+        ``LinearOperator``) runs the numpy reference PCG :func:`_block_pcg`.
 
     Raises
     ------
     SolverDidNotConverge
         method="cg" and CG did not reach ``rtol`` within ``maxiter`` iterations.
     """
+    from . import solvers
     R = np.asarray(R, dtype=np.float64)
     vec = R.ndim == 1
     if vec:
@@ -271,21 +290,41 @@ def solve_spd(A, R, *, method="auto", rtol=1e-10, maxiter=None, preconditioner=N
     if method == "auto" and n <= AUTO_DIRECT_MAX:
         method = "direct"
     X = None
-    if method == "auto" and maxiter is None:
-        maxiter = AUTO_CG_MAXITER
-    if method in ("cg", "auto"):
-        try:
-            X = _block_pcg(sp.csr_matrix(A), R, rtol, maxiter, preconditioner)
-        except SolverDidNotConverge:
-            if method == "cg":
-                raise
+    if maxiter is None:
+        maxiter = AUTO_CG_MAXITER if method == "auto" else 2000
+    if method in ("cg", "auto") and n > 0:
+        if preconditioner is not None and not sp.issparse(preconditioner):
+            try:
+                X = _block_pcg(sp.csr_matrix(A), R, rtol, maxiter, preconditioner)
+            except SolverDidNotConverge:
+                if method == "cg":
+                    raise
+        else:
+            Ac = sp.csr_matrix(A)
+            Mc = None
+            dinv = None
+            if preconditioner is None:
+                dinv = 1.0 / Ac.diagonal()
+            else:
+                Mc = sp.csr_matrix(preconditioner)
+                Mc = (Mc.indptr, Mc.indices, Mc.data)
+            Xc, it, status, relres = solvers.pcg(
+                Ac.indptr, Ac.indices, Ac.data, R, rtol=rtol, maxiter=maxiter, M=Mc, dinv=dinv,
+                probe_iter=20 if method == "auto" else 0, max_predicted=maxiter)
+            if status == 0:
+                X = Xc
+            elif method == "cg":
+                raise SolverDidNotConverge(
+                    f"preconditioned CG did not converge in {it} iterations "
+                    f"(relative residual {max(relres):.2e} > {rtol:.1e}); the mesh may contain "
+                    f"near-degenerate triangles. Use solver='direct' or solver='auto'.")
     if X is None:
-        X = np.zeros_like(R) if n == 0 else spla.splu(sp.csc_matrix(A)).solve(R)
+        X = np.zeros_like(R) if n == 0 else solvers.cholesky_solve(A, R)
     return X[:, 0] if vec else X
 
 
 def _block_pcg(A, R, rtol, maxiter, M=None):
-    """Preconditioned CG on the columns of R at once (independent recurrences,
+    """The numpy reference of the compiled block PCG: CG on the columns of R at once (independent recurrences,
     shared sparse products).  Buffers are reused: at 10⁵–10⁶ unknowns each
     iteration is memory-bound."""
     n, k = R.shape

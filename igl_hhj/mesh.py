@@ -50,7 +50,7 @@ import warnings
 import numpy as np
 
 __all__ = ["TriangleMesh", "validate_mesh", "as_mesh", "mark_bad_vertices", "MeshWarning",
-           "DEGENERATE_AREA_RTOL", "COORDINATE_MAX", "MIN_MESH_SIZE"]
+           "DEGENERATE_AREA_RTOL", "COORDINATE_MAX", "MIN_MESH_SIZE", "topology_reference"]
 
 DEGENERATE_AREA_RTOL = 1e-7
 """A face with ``2|T| ≤ DEGENERATE_AREA_RTOL × (longest edge)²`` (smallest angle
@@ -217,6 +217,8 @@ class TriangleMesh:
         self._check_degenerate()
         self._check_manifold_and_orientation()
         self._warn_unwelded()
+        # the (#F, 3, 3) edge vectors are recomputed on demand (memory: 72 B/face)
+        self.__dict__.pop("_edge_vectors", None)
 
     # ------------------------------------------------------------------ sizes
     @property
@@ -233,33 +235,35 @@ class TriangleMesh:
 
     # ------------------------------------------------------------ topology
     @cached_property
-    def _unique_edge_map(self):
-        import igl
-        E, uE, EMAP, uEC, uEE = igl.unique_edge_map(self.F)
-        return E, uE, EMAP, uEC, uEE
+    def _topology(self):
+        # one compiled pass (igl_hhj.kernels.topology); reference: topology_reference
+        from . import kernels
+        out = kernels.topology(self.F, self.n_vertices)
+        for a in out:
+            a.flags.writeable = False
+        return out
 
     @cached_property
     def edges(self):
-        """(#E, 2) int64: unique undirected edges (``uE`` of ``igl.unique_edge_map``)."""
-        return self._unique_edge_map[1]
+        """(#E, 2) int64: unique undirected edges as ``(min, max)`` vertex pairs, in
+        lexicographic order (the order of ``uE`` of ``igl.unique_edge_map``)."""
+        return self._topology[0]
 
     @cached_property
     def face_edges(self):
         """(#F, 3) int64: ``face_edges[f, i]`` = unique edge opposite corner ``i`` of face ``f``."""
-        nF = self.n_faces
-        return np.ascontiguousarray(self._unique_edge_map[2].reshape(3, nF).T)
+        return self._topology[1]
 
     @cached_property
     def edge_face_count(self):
         """(#E,) int64: number of faces incident to each unique edge (1 = boundary)."""
-        return np.diff(self._unique_edge_map[3])
+        return self._topology[2]
 
     @cached_property
     def face_edge_sign(self):
         """(#F, 3) float64: +1 where the half-edge ``x_{i+1} → x_{i+2}`` of face f
         runs in the direction of the unique edge ``edges[face_edges[f, i]]``, else -1."""
-        src = self.F[:, [1, 2, 0]]
-        return np.where(self.edges[self.face_edges, 0] == src, 1.0, -1.0)
+        return self._topology[5]
 
     @cached_property
     def edge_faces(self):
@@ -267,22 +271,12 @@ class TriangleMesh:
 
         Column 0 holds the face in which the edge is positively oriented
         (``face_edge_sign == +1``), column 1 the other one."""
-        nF = self.n_faces
-        ef = -np.ones((self.n_edges, 2), dtype=np.int64)
-        f = np.repeat(np.arange(nF), 3)
-        e = self.face_edges.ravel()
-        col = (self.face_edge_sign.ravel() < 0).astype(np.int64)
-        ef[e, col] = f
-        return ef
+        return self._topology[3]
 
     @cached_property
     def edge_local_index(self):
         """(#E, 2) int64: local index (0..2) of the edge inside each face of ``edge_faces``; -1 for none."""
-        li = -np.ones((self.n_edges, 2), dtype=np.int64)
-        e = self.face_edges.ravel()
-        col = (self.face_edge_sign.ravel() < 0).astype(np.int64)
-        li[e, col] = np.tile(np.arange(3), self.n_faces)
-        return li
+        return self._topology[4]
 
     @cached_property
     def boundary_edges(self):
@@ -320,17 +314,27 @@ class TriangleMesh:
     def _edge_vectors(self):
         """(#F, 3, 3): vector of edge i of face f, ``x_{i+2} - x_{i+1}``."""
         X = self.V[self.F]  # (#F, 3 corners, 3)
-        return X[:, [2, 0, 1]] - X[:, [1, 2, 0]]
+        ev = np.empty_like(X)
+        np.subtract(X[:, 2], X[:, 1], out=ev[:, 0])
+        np.subtract(X[:, 0], X[:, 2], out=ev[:, 1])
+        np.subtract(X[:, 1], X[:, 0], out=ev[:, 2])
+        return ev
 
     @cached_property
     def _cross(self):
-        X = self.V[self.F]
-        return np.cross(X[:, 1] - X[:, 0], X[:, 2] - X[:, 0])
+        """(#F, 3): ``(x1 - x0) × (x2 - x0)`` = ``ev_2 × (-ev_1)``, by components."""
+        a, b = self._edge_vectors[:, 2], -self._edge_vectors[:, 1]
+        c = np.empty_like(a)
+        c[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+        c[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+        c[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+        return c
 
     @cached_property
     def face_double_areas(self):
         """(#F,) float64: twice the face areas, ``|(x1 - x0) × (x2 - x0)|``."""
-        return np.linalg.norm(self._cross, axis=1)
+        c = self._cross
+        return np.sqrt(np.einsum("fa,fa->f", c, c))
 
     @cached_property
     def face_areas(self):
@@ -559,3 +563,30 @@ def per_vertex_array(mesh, values, name, shape_tail=()):
     if A.shape != want:
         raise ValueError(f"{name} must have shape {want}, got {A.shape}")
     return np.ascontiguousarray(A, dtype=np.float64)
+
+
+def topology_reference(F):
+    """The readable reference of :attr:`TriangleMesh._topology` (tests compare the two).
+
+    From ``igl.unique_edge_map``: ``EMAP[f + c*#F]`` is the edge opposite corner
+    ``c`` of face ``f``; edges are re-oriented as ``(min, max)``.
+
+    Returns ``(edges, face_edges, count, edge_faces, edge_local_index, face_edge_sign)``
+    as :func:`igl_hhj.kernels.topology`.
+    """
+    import igl
+    F = np.ascontiguousarray(F, dtype=np.int64)
+    nF = F.shape[0]
+    _, uE, EMAP, uEC, _ = igl.unique_edge_map(F)
+    edges = np.sort(np.asarray(uE, dtype=np.int64), axis=1)
+    face_edges = np.ascontiguousarray(np.asarray(EMAP).reshape(3, nF).T)
+    count = np.diff(uEC)
+    src = F[:, [1, 2, 0]]
+    sign = np.where(edges[face_edges, 0] == src, 1.0, -1.0)
+    nE = edges.shape[0]
+    ef = -np.ones((nE, 2), dtype=np.int64)
+    li = -np.ones((nE, 2), dtype=np.int64)
+    col = (sign.ravel() < 0).astype(np.int64)
+    ef[face_edges.ravel(), col] = np.repeat(np.arange(nF), 3)
+    li[face_edges.ravel(), col] = np.tile(np.arange(3), nF)
+    return edges, face_edges, count, ef, li, sign

@@ -1,11 +1,30 @@
-"""The speed benchmark runs (on tiny sizes) and reports what it measured."""
+"""The speed benchmark runs (on its quick meshes) and reports what it measured."""
+import numpy as np
+
 from igl_hhj.benchmarks import speed
 
 
-def test_speed_run_small(tmp_path):
-    rows = speed.run(max_faces=25_000, repeat=1, solvers=("auto", "cg"), progress=False)
-    assert {r["surface"] for r in rows} == {"ellipsoid", "torus"}
+def test_speed_run_quick():
+    rows = speed.run(speed.QUICK, repeat=1, progress=False, memory=True)
+    assert len(rows) == 3
     for r in rows:
-        assert r["libigl"] > 0 and r["hhj_auto"] > 0 and r["hhj_cg"] > 0 and r["dropin"] > 0
-    table = speed.markdown(rows, solvers=("auto", "cg"))
-    assert table.count("\n") == len(rows) + 1 and "ratio libigl/drop-in" in table
+        assert r["libigl"] > 0 and r["dropin"] > 0 and r["S_auto"] > 0 and r["S_cg"] > 0
+        assert r["chosen"].split()[0] in ("cg", "direct") and r["iterations"] >= 0
+        assert r["kb_per_face"] > 0 and r["first_over_later"] > 0 and 0 < r["min_angle"] < 60
+    table = speed.markdown(rows)
+    assert table.count("\n") == len(rows) + 1 and "peak KB/face" in table
+
+
+def test_min_angle_of_equilateral_triangle():
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [0.5, np.sqrt(3) / 2, 0]])
+    assert abs(speed.min_angle_degrees(V, np.array([[0, 1, 2]])) - 60.0) < 1e-9
+
+
+def test_rtol_study_small():
+    rows = speed.rtol_study(faces=(5_000,), rtols=(1e-4, 1e-12), torus_levels=0)
+    assert len(rows) == 4
+    tight = [r for r in rows if r["rtol"] == 1e-12]
+    loose = [r for r in rows if r["rtol"] == 1e-4]
+    assert all(r["change"] == 0 for r in tight)
+    assert all(lo["iterations"] < ti["iterations"] for lo, ti in zip(loose, tight))
+    assert "change vs rtol 1e-12" in speed.rtol_markdown(rows)

@@ -1,19 +1,34 @@
-"""Speed of igl_hhj against ``igl.principal_curvature``, measured in the same run.
+"""Speed of the drop-in ``igl_hhj.principal_curvature`` against ``igl.principal_curvature``,
+measured in the same run.
 
-    python -m igl_hhj.benchmarks.speed [--max-faces 1400000] [--repeat 1] [--out DIR]
+    python -m igl_hhj.benchmarks.speed [--quick] [--repeat 3] [--meshes DIR] [--out DIR]
+    python -m igl_hhj.benchmarks.speed --rtol-study | --sliver-study | --profile 'icosphere(8)'
 
-Meshes: a jittered ellipsoid refined uniformly (well-shaped triangles) and
-Walker's torus from a perturbed grid with random diagonals (minimum angle ≈ 6°,
-the hard case for the HHJ solver), from ~10k to ≥ 1M faces.  For each mesh it
-times ``igl.principal_curvature`` (libigl's quadric fitting, default 5-ring),
-``igl_hhj.shape_operator`` with the default solver ("auto"), with PCG and with
-the sparse direct solver (up to 400k faces), and the drop-in ``igl_hhj.principal_curvature``;
-prints seconds, µs/face and the ratio ``t_libigl / t_igl_hhj`` (> 1: igl_hhj
-is faster).  Writes ``speed.md`` to ``--out`` (default ``./benchmark-results/``).
+Meshes: icosphere(7) (328k faces) and icosphere(8) (1.31M), a jittered ellipsoid at
+82k / 328k / 1.31M faces (linear-scaling check), Walker's torus from a perturbed grid
+with random diagonals (6° slivers, 262k faces), every mesh in ``../shared/data/meshes``
+(``--meshes``) plus the bunny refined twice by ``igl.upsample``, and an open scan-like
+height field (jittered grid with random diagonals cropped to a disc, 5° slivers).
+
+For each mesh it prints: the smallest angle; the best-of-``--repeat`` wall time of
+``igl.principal_curvature`` (default 5-ring quadric fit) and of the drop-in; the ratio
+``t_libigl / t_drop-in`` (> 1: igl_hhj is faster); µs per face; the time of
+``igl_hhj.shape_operator`` with ``solver="direct"``, ``"cg"`` and ``"auto"`` (auto must
+never be slower than both); what "auto" chose and its PCG iterations; the peak memory of
+one drop-in call above the input (KB per face, in a fresh subprocess after a warm-up call
+on a tiny mesh: the peak resident size ``VmHWM``, reset just before the call, minus the
+resident size before it) and how much slower
+the first call in a fresh process is than the best later one.  Writes ``speed.md`` to
+``--out``.
 """
 from __future__ import annotations
 
 import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -21,94 +36,364 @@ import numpy as np
 
 from . import progress as progress_bar
 
-SOLVERS = ("auto", "cg", "direct")
-# splu's fill grows superlinearly: above this many faces the direct column is skipped
+# the direct column is skipped above this many faces (fill, minutes of factorisation)
 DIRECT_MAX_FACES = 400_000
+QUICK = ("icosphere(4)", "ellipsoid 20k", "open scan 5k")
+FULL = ("icosphere(7)", "icosphere(8)", "ellipsoid 82k", "ellipsoid 328k", "ellipsoid 1.31M",
+        "torus 262k", "open scan 51k", "bunny upsampled ×2", "real")
 
 
-def _meshes(max_faces):
-    from ..surfaces import (Ellipsoid, WalkerTorus, ellipsoid_coarse, refine, torus_coarse)
+def _default_mesh_dir():
+    for base in (Path.cwd(), Path(__file__).resolve().parents[2]):
+        d = base.parent / "shared" / "data" / "meshes"
+        if d.is_dir():
+            return d
+    return None
+
+
+def _open_scan(n):
+    """Open scan-like height field: WalkerSaddle over a jittered grid with random
+    diagonals, cropped to a disc (irregular boundary, 5° slivers)."""
+    from ..surfaces import WalkerSaddle, square_grid
+    P, F = square_grid(n, amount=0.42, seed=7)
+    c = P[F].mean(axis=1) - 0.5
+    F = F[(c ** 2).sum(axis=1) < 0.24]
+    used = np.unique(F)
+    remap = -np.ones(len(P), dtype=np.int64)
+    remap[used] = np.arange(len(used))
+    return WalkerSaddle().lift(P[used]), remap[F]
+
+
+def _ellipsoid(faces):
+    from ..surfaces import Ellipsoid, ellipsoid_coarse, refine
     ell = Ellipsoid()
     V, F = ellipsoid_coarse(ell, subdivisions=3, amount=0.2)          # 1280 faces
-    V, F = refine(V, F, ell, 2)                                        # 20k faces
-    while len(F) <= max_faces:
-        yield "ellipsoid", V, F
+    while len(F) < faces:
         V, F = refine(V, F, ell, 1)
-    tor = WalkerTorus()
-    V, F = torus_coarse(n_phi=32, n_t=16, amount=0.25)                 # 1024 faces
-    V, F = refine(V, F, tor, 2)                                        # 16k faces
-    while len(F) <= max_faces:
-        yield "torus", V, F
-        V, F = refine(V, F, tor, 1)
+    return V, F
 
 
-def _time(fn, repeat):
+def _build(name, mesh_dir):
+    """[(label, V, F)] for one entry of QUICK / FULL."""
+    import igl
+    from ..surfaces import WalkerTorus, icosphere, refine, torus_coarse
+    if name.startswith("icosphere("):
+        V, F = icosphere(int(name[10:-1]))
+        return [(name, V, F)]
+    if name.startswith("ellipsoid"):
+        target = {"20k": 20_000, "82k": 80_000, "328k": 320_000, "1.31M": 1_300_000}[name.split()[1]]
+        return [(f"jittered ellipsoid", *_ellipsoid(target))]
+    if name == "torus 262k":
+        V, F = torus_coarse(n_phi=32, n_t=16, amount=0.25)
+        return [("Walker torus (sliver grid)", *refine(V, F, WalkerTorus(), 4))]
+    if name.startswith("open scan"):
+        n = 36 if name.endswith("5k") else 160
+        return [("open scan-like height field", *_open_scan(n))]
+    if mesh_dir is None:
+        return []
+    if name == "bunny upsampled ×2":
+        p = mesh_dir / "bunny.off"
+        if not p.exists():
+            return []
+        V, F = igl.read_triangle_mesh(str(p))
+        return [(name, *igl.upsample(V, F, 2))]
+    if name == "real":
+        out = []
+        for p in sorted(mesh_dir.glob("*.off")):
+            V, F = igl.read_triangle_mesh(str(p))
+            out.append((p.name, V, F))
+        return out
+    raise KeyError(name)
+
+
+def min_angle_degrees(V, F):
+    """Smallest interior angle of the mesh in degrees."""
+    X = V[F]
+    l = np.linalg.norm(X[:, [2, 0, 1]] - X[:, [1, 2, 0]], axis=2)
+    dbl = np.linalg.norm(np.cross(X[:, 1] - X[:, 0], X[:, 2] - X[:, 0]), axis=1)
+    s = dbl * l.min(axis=1) / l.prod(axis=1)
+    return float(np.degrees(np.arcsin(np.clip(s.min(), 0, 1))))
+
+
+def _best(fn, repeat):
     best = np.inf
+    out = None
     for _ in range(repeat):
         t = time.perf_counter()
-        fn()
+        out = fn()
         best = min(best, time.perf_counter() - t)
-    return best
+    return best, out
 
 
-def run(max_faces=1_400_000, repeat=1, solvers=SOLVERS, progress=True):
-    """Time libigl and igl_hhj on every mesh up to ``max_faces`` faces.
+_CHILD_TIME = r"""
+import json, sys, time
+import numpy as np
+t = time.perf_counter(); import igl_hhj; t_import = time.perf_counter() - t
+d = np.load(sys.argv[1]); V, F = d["V"], d["F"]
+t = time.perf_counter(); igl_hhj.principal_curvature(V, F); first = time.perf_counter() - t
+later = float("inf")
+for _ in range(int(sys.argv[2])):
+    t = time.perf_counter(); igl_hhj.principal_curvature(V, F); later = min(later, time.perf_counter() - t)
+print(json.dumps({"import": t_import, "first": first, "later": later}))
+"""
+
+# Peak RSS from /proc/self/status VmHWM, reset to the current RSS just before the call
+# (writing 5 to /proc/self/clear_refs); ru_maxrss would include the parent's RSS at fork.
+_CHILD_MEMORY = r"""
+import json, sys
+import numpy as np
+import igl_hhj
+from igl_hhj.surfaces import icosphere
+igl_hhj.principal_curvature(*icosphere(2))        # imports and one-time set-up
+d = np.load(sys.argv[1]); V, F = d["V"], d["F"]
+def status(key):
+    with open("/proc/self/status") as fh:
+        for line in fh:
+            if line.startswith(key):
+                return int(line.split()[1]) * 1024
+base = status("VmRSS:")
+with open("/proc/self/clear_refs", "w") as fh:
+    fh.write("5")
+igl_hhj.principal_curvature(V, F)
+print(json.dumps({"peak": status("VmHWM:") - base}))
+"""
+
+
+def _child_measure(V, F, repeat):
+    """In fresh processes: import time, first-call and best later time of the drop-in;
+    peak resident memory of one call above the input (after a warm-up call on a
+    320-face mesh, so that imports are not counted)."""
+    out = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "mesh.npz")
+        np.savez(path, V=np.ascontiguousarray(V, dtype=np.float64), F=np.ascontiguousarray(F, dtype=np.int64))
+        for code in (_CHILD_TIME, _CHILD_MEMORY):
+            res = subprocess.run([sys.executable, "-c", code, path, str(max(1, repeat))],
+                                 capture_output=True, text=True, check=True)
+            out.update(json.loads(res.stdout.strip().splitlines()[-1]))
+    return out
+
+
+def run(names=FULL, repeat=3, mesh_dir=None, progress=True, memory=True):
+    """Time libigl and igl_hhj on the named meshes (entries of :data:`FULL` / :data:`QUICK`).
 
     Returns
     -------
-    list of dict rows: ``surface, faces, libigl, hhj_<solver>..., dropin`` (seconds).
+    list of dict rows (seconds, counts, KB/face).
     """
     import igl
 
     import igl_hhj
-    meshes = list(_meshes(max_faces))
+    from igl_hhj.curvature import _shape_operator
+    from igl_hhj.mesh import TriangleMesh
+    mesh_dir = _default_mesh_dir() if mesh_dir is None else Path(mesh_dir)
+    meshes = [m for n in names for m in _build(n, mesh_dir)]
     rows = []
-    for name, V, F in progress_bar(meshes, "speed", "mesh", progress):
-        row = {"surface": name, "faces": len(F)}
-        row["libigl"] = _time(lambda: igl.principal_curvature(V, F), repeat)
-        for s in solvers:
-            if s == "direct" and len(F) > DIRECT_MAX_FACES:
-                row[f"hhj_{s}"] = float("nan")
+    for label, V, F in progress_bar(meshes, "speed", "mesh", progress):
+        nF = len(F)
+        rep = repeat if nF < 1_000_000 else max(1, repeat - 1)
+        row = {"mesh": label, "faces": nF, "min_angle": min_angle_degrees(V, F)}
+        row["libigl"], _ = _best(lambda: igl.principal_curvature(V, F), rep)
+        row["dropin"], _ = _best(lambda: igl_hhj.principal_curvature(V, F), rep)
+        for s in ("direct", "cg", "auto"):
+            if s == "direct" and nF > DIRECT_MAX_FACES:
+                row["S_direct"] = float("nan")
                 continue
-            row[f"hhj_{s}"] = _time(lambda: igl_hhj.shape_operator(V, F, solver=s), repeat)
-        row["dropin"] = _time(lambda: igl_hhj.principal_curvature(V, F), repeat)
+            try:
+                row[f"S_{s}"], _ = _best(lambda: igl_hhj.shape_operator(V, F, solver=s), rep)
+            except igl_hhj.SolverError:
+                row[f"S_{s}"] = float("nan")
+        info = {}
+        _shape_operator(TriangleMesh(V, F), None, None, None, "auto", info=info)
+        row["chosen"] = info["solver"] + (" (switched)" if info.get("switched") else "")
+        row["iterations"] = info["iterations"]
+        row["sliver_dofs"] = info.get("sliver_dofs", 0)
+        if memory:
+            child = _child_measure(V, F, min(rep, 2))
+            row["kb_per_face"] = child["peak"] / 1024 / nF
+            row["first_over_later"] = child["first"] / child["later"]
+            row["import"] = child["import"]
         rows.append(row)
     return rows
 
 
-def markdown(rows, solvers=SOLVERS):
-    head = ["surface", "faces", "libigl (s)"] + [f"S_h {s} (s)" for s in solvers] + \
-        ["drop-in (s)", "drop-in µs/face", "ratio libigl/drop-in", "ratio libigl/S_h auto"]
-    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+RTOLS = (1e-3, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
+
+
+def rtol_study(faces=(20_000, 80_000, 320_000), rtols=RTOLS, torus_levels=3):
+    """How the PCG tolerance shows in the drop-in's error against the exact surface.
+
+    Jittered ellipsoids (exact principal curvatures known) and Walker's sliver torus;
+    for each ``rtol``: PCG iterations and the L2 vertex error of H = (κ1+κ2)/2
+    relative to the same error at rtol = 1e-12.
+
+    Returns
+    -------
+    list of dict rows: ``mesh, faces, rtol, iterations, err_H, change``.
+    """
+    from igl_hhj.convergence import vertex_errors
+    from igl_hhj.curvature import _shape_operator, vertex_principal_curvature, vertex_shape_operator
+    from igl_hhj.mesh import TriangleMesh
+    from ..surfaces import Ellipsoid, WalkerTorus, refine, torus_coarse
+    cases = [("jittered ellipsoid", Ellipsoid(), *_ellipsoid(n)) for n in faces]
+    V, F = torus_coarse(n_phi=32, n_t=16, amount=0.25)
+    cases.append(("Walker torus (sliver grid)", WalkerTorus(), *refine(V, F, WalkerTorus(), torus_levels)))
+    rows = []
+    for label, surface, V, F in cases:
+        m = TriangleMesh(V, F)
+        errs = {}
+        for rtol in sorted(rtols, reverse=False):
+            info = {}
+            S = _shape_operator(m, None, None, None, "cg", rtol, info)
+            Sv, N = vertex_shape_operator(m, S)
+            _, _, PV1, PV2 = vertex_principal_curvature(m, Sv, N)
+            errs[rtol] = (vertex_errors(m, None, PV1, PV2, surface)["H"], info["iterations"])
+        ref = errs[min(rtols)][0]
+        for rtol in rtols:
+            e, it = errs[rtol]
+            rows.append({"mesh": label, "faces": len(F), "rtol": rtol, "iterations": it,
+                         "err_H": e, "change": abs(e - ref) / ref})
+    return rows
+
+
+def rtol_markdown(rows):
+    lines = ["| mesh | faces | rtol | PCG its | L2 error of H at vertices | change vs rtol 1e-12 |",
+             "|---|---|---|---|---|---|"]
     for r in rows:
-        cells = [r["surface"], f"{r['faces']:,}", f"{r['libigl']:.3f}"]
-        cells += ["–" if np.isnan(r[f"hhj_{s}"]) else f"{r[f'hhj_{s}']:.3f}" for s in solvers]
-        cells += [f"{r['dropin']:.3f}", f"{1e6 * r['dropin'] / r['faces']:.2f}",
-                  f"{r['libigl'] / r['dropin']:.2f}×"]
-        cells += [f"{r['libigl'] / r['hhj_auto']:.2f}×" if "hhj_auto" in r else "–"]
+        lines.append(f"| {r['mesh']} | {r['faces']:,} | {r['rtol']:.0e} | {r['iterations']} | "
+                     f"{r['err_H']:.4e} | {100 * r['change']:.4f} % |")
+    return "\n".join(lines)
+
+
+SLIVER_ANGLES = (0, 5, 10, 15, 20, 25)
+SLIVER_MESHES = ("camelhead.off", "bunny upsampled ×2", "open scan-like height field", "jittered ellipsoid")
+
+
+def sliver_study(angles=SLIVER_ANGLES, mesh_dir=None, rtol=1e-8):
+    """PCG iterations and CPU time of the compiled solve against the sliver threshold
+    of the two-level preconditioner (0 = face-Schwarz alone), single thread."""
+    from igl_hhj import kernels, solvers
+    from igl_hhj.mesh import TriangleMesh
+    mesh_dir = _default_mesh_dir() if mesh_dir is None else Path(mesh_dir)
+    meshes = [m for n in ("real", "bunny upsampled ×2", "open scan 51k", "ellipsoid 328k")
+              for m in _build(n, mesh_dir) if m[0] in SLIVER_MESHES]
+    old, threads = solvers.SLIVER_ANGLE, kernels.max_threads()
+    rows = []
+    try:
+        kernels.set_num_threads(1)
+        for label, V, F in meshes:
+            m = TriangleMesh(V, F)
+            rhs = -kernels.jump_apply(m, m.V)
+            system = solvers.HHJSystem(m)
+            for a in angles:
+                solvers.SLIVER_ANGLE = a
+                t = time.process_time()
+                _, info = system.solve(rhs, "cg", rtol)
+                rows.append({"mesh": label, "faces": len(F), "angle": a, "seconds": time.process_time() - t,
+                             "iterations": info["iterations"],
+                             "fraction": info.get("sliver_dofs", 0) / system.n})
+    finally:
+        solvers.SLIVER_ANGLE = old
+        kernels.set_num_threads(threads)
+    return rows
+
+
+def profile_stages(V, F, rtol=None):
+    """CPU seconds (single thread) of the drop-in's stages on one mesh."""
+    from igl_hhj import kernels, solvers
+    from igl_hhj.mesh import TriangleMesh
+    threads = kernels.max_threads()
+    kernels.set_num_threads(1)
+    out = {}
+
+    def stage(name, fn):
+        t = time.process_time()
+        r = fn()
+        out[name] = time.process_time() - t
+        return r
+    try:
+        m = stage("validation + topology", lambda: (TriangleMesh(V, F), None)[0])
+        system = stage("HHJ assembly + preconditioner", lambda: solvers.HHJSystem(m))
+        rhs = stage("load -B X", lambda: -kernels.jump_apply(m, m.V))
+        s, info = stage("PCG", lambda: system.solve(rhs, "cg", rtol or solvers.DEFAULT_RTOL))
+        S = stage("S_h", lambda: kernels.shape_operator_faces(m, s))
+        N = stage("vertex normals", lambda: m.vertex_normals)
+        Sv = stage("recovery", lambda: kernels.lumped_vertex_recovery(m, S, N))
+        stage("2x2 eigen", lambda: kernels.principal_2x2(Sv, N))
+        out["PCG iterations"] = info["iterations"]
+    finally:
+        kernels.set_num_threads(threads)
+    return out
+
+
+def markdown(rows):
+    head = ["mesh", "faces", "min angle", "libigl (s)", "drop-in (s)", "ratio", "µs/face",
+            "S_h direct (s)", "S_h cg (s)", "S_h auto (s)", "auto chose", "PCG its",
+            "peak KB/face", "1st call / later"]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    f3 = lambda x: "–" if not np.isfinite(x) else f"{x:.3f}"  # noqa: E731
+    for r in rows:
+        cells = [r["mesh"], f"{r['faces']:,}", f"{r['min_angle']:.2f}°", f3(r["libigl"]),
+                 f3(r["dropin"]), f"**{r['libigl'] / r['dropin']:.2f}×**",
+                 f"{1e6 * r['dropin'] / r['faces']:.2f}", f3(r["S_direct"]), f3(r["S_cg"]),
+                 f3(r["S_auto"]), r["chosen"], str(r["iterations"]),
+                 f"{r['kb_per_face']:.2f}" if "kb_per_face" in r else "–",
+                 f"{r['first_over_later']:.2f}" if "first_over_later" in r else "–"]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--max-faces", type=int, default=1_400_000,
-                   help="largest mesh timed, in faces (default 1400000; 100000 takes seconds)")
-    p.add_argument("--repeat", type=int, default=1, help="best of N runs per timing")
+    p.add_argument("--quick", action="store_true", help="three small meshes (seconds)")
+    p.add_argument("--repeat", type=int, default=3, help="best of N runs per timing")
+    p.add_argument("--meshes", default=None, help="folder of real meshes (default ../shared/data/meshes)")
+    p.add_argument("--no-memory", action="store_true", help="skip the fresh-process memory column")
     p.add_argument("--out", default="benchmark-results",
                    help="folder for speed.md (default ./benchmark-results/)")
+    p.add_argument("--sliver-study", action="store_true",
+                   help="only PCG iterations / CPU time against the sliver threshold")
+    p.add_argument("--profile", default=None, metavar="MESH",
+                   help="only the CPU time of each stage on one mesh, e.g. 'icosphere(8)'")
+    p.add_argument("--rtol-study", action="store_true",
+                   help="only the tolerance study (PCG iterations and error vs rtol)")
     a = p.parse_args(argv)
-    rows = run(a.max_faces, a.repeat)
+    if a.sliver_study:
+        rows = sliver_study(mesh_dir=a.meshes)
+        lines = ["| mesh | faces | sliver angle | sliver DOFs | PCG its | CPU s |", "|---|---|---|---|---|---|"]
+        lines += [f"| {r['mesh']} | {r['faces']:,} | {r['angle']}° | {100 * r['fraction']:.0f} % | "
+                  f"{r['iterations']} | {r['seconds']:.3f} |" for r in rows]
+        print("\n".join(lines))
+        return
+    if a.profile:
+        V, F = _build(a.profile, None)[0][1:]
+        for k, v in profile_stages(V, F).items():
+            print(f"{k}: {v:.3f}" if isinstance(v, float) else f"{k}: {v}")
+        return
+    if a.rtol_study:
+        table = rtol_markdown(rtol_study())
+        print(table)
+        out = Path(a.out)
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "speed_rtol.md").write_text(table + "\n")
+        return
+    rows = run(QUICK if a.quick else FULL, a.repeat, a.meshes, memory=not a.no_memory)
     table = markdown(rows)
     import importlib.metadata
     import platform
-    header = (f"# igl_hhj speed vs igl.principal_curvature (same run)\n\n"
+
+    from igl_hhj import kernels
+    imp = f"import igl_hhj {rows[0]['import']:.2f} s (fresh process); " if rows and "import" in rows[0] else ""
+    header = (f"# igl_hhj drop-in speed vs igl.principal_curvature (same run)\n\n"
               f"libigl {importlib.metadata.version('libigl')}, numpy {np.__version__}, "
-              f"{platform.processor() or platform.machine()}, best of {a.repeat}.\n\n")
-    print(table)
+              f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+              f"{kernels.max_threads()} OpenMP threads, best of {a.repeat}; {imp}"
+              f"load average at the end {os.getloadavg()[0]:.1f}.\n\n")
+    print(header + table)
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "speed.md").write_text(header + table + "\n")
+    (out / "speed.json").write_text(json.dumps(rows, indent=1))
     print(f"\nwrote {out / 'speed.md'}")
 
 

@@ -1,0 +1,226 @@
+// The only file that knows nanobind: ndarrays in (C-contiguous float64 / int64,
+// shapes checked in igl_hhj/kernels.py and again here where an index could go
+// out of bounds), ndarrays out (owned by Python), the GIL released around work.
+#include <nanobind/nanobind.h>
+#include <nanobind/ndarray.h>
+#include <nanobind/stl/tuple.h>
+#include <nanobind/stl/vector.h>
+#include <nanobind/stl/optional.h>
+#include <optional>
+
+#include "core.hpp"
+
+namespace nb = nanobind;
+using namespace nb::literals;
+using hhj::i64;
+
+template <class T>
+using In = nb::ndarray<const T, nb::c_contig, nb::device::cpu>;
+template <class T>
+using Out = nb::ndarray<nb::numpy, T>;
+
+template <class T>
+static Out<T> to_numpy(std::vector<T>&& v, std::initializer_list<size_t> shape) {
+    auto* heap = new std::vector<T>(std::move(v));
+    nb::capsule owner(heap, [](void* p) noexcept { delete static_cast<std::vector<T>*>(p); });
+    return Out<T>(heap->data(), shape, owner);
+}
+
+static void need(bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(what);
+}
+
+NB_MODULE(_hhj_core, m) {
+    m.doc() = "igl_hhj compiled core (use igl_hhj.kernels, not this module directly)";
+
+    m.def("max_threads", []() {
+#ifdef IGL_HHJ_OPENMP
+        return omp_get_max_threads();
+#else
+        return 1;
+#endif
+    });
+    m.def("set_num_threads", [](int n) {
+#ifdef IGL_HHJ_OPENMP
+        omp_set_num_threads(n < 1 ? 1 : n);
+#else
+        (void)n;
+#endif
+    });
+    m.def("has_openmp", []() {
+#ifdef IGL_HHJ_OPENMP
+        return true;
+#else
+        return false;
+#endif
+    });
+
+    m.def("topology", [](In<i64> F, i64 nV) {
+        need(F.ndim() == 2 && F.shape(1) == 3, "F must be (#F, 3)");
+        const i64 nF = F.shape(0);
+        hhj::Topology T;
+        {
+            nb::gil_scoped_release nogil;
+            hhj::ThreadBudget tb(0);
+            hhj::topology(F.data(), nF, nV, T);
+        }
+        const size_t nE = T.n_edges, nf = nF;
+        return nb::make_tuple(to_numpy(std::move(T.edges), {nE, 2}),
+                              to_numpy(std::move(T.face_edges), {nf, 3}),
+                              to_numpy(std::move(T.count), {nE}),
+                              to_numpy(std::move(T.edge_faces), {nE, 2}),
+                              to_numpy(std::move(T.local_index), {nE, 2}),
+                              to_numpy(std::move(T.sign), {nf, 3}));
+    }, "F"_a, "nV"_a);
+
+    m.def("edge_morton_order", [](In<double> V, In<i64> E) {
+        need(V.ndim() == 2 && V.shape(1) == 3 && E.ndim() == 2 && E.shape(1) == 2, "edge_morton_order: shapes");
+        const i64 nE = E.shape(0);
+        std::vector<i64> perm(nE);
+        {
+            nb::gil_scoped_release nogil;
+            hhj::ThreadBudget tb(0);
+            hhj::edge_morton_order(V.data(), V.shape(0), E.data(), nE, perm.data());
+        }
+        return to_numpy(std::move(perm), {(size_t)nE});
+    });
+
+    m.def("hhj_system", [](In<double> V, In<i64> F, In<i64> FE, In<i64> EF, In<i64> ELI,
+                           std::optional<In<unsigned char>> fixed, bool schwarz) {
+        const i64 nF = F.shape(0), nE = EF.shape(0);
+        need(FE.shape(0) == (size_t)nF && ELI.shape(0) == (size_t)nE, "hhj_system: inconsistent shapes");
+        need(!fixed || fixed->shape(0) == (size_t)nE, "hhj_system: fixed must be (#E,)");
+        need(nE < ((i64)1 << 31), "hhj_system: at most 2**31 - 1 edges");
+        std::vector<std::int32_t> cols((size_t)nE * 5);
+        std::vector<double> A((size_t)nE * 5), M, sin_min(nF);
+        i64 n_jacobi = 0;
+        {
+            nb::gil_scoped_release nogil;
+            hhj::ThreadBudget tb(nF);
+            std::vector<double> Aloc((size_t)nF * 9);
+            hhj::local_mass(V.data(), F.data(), nF, Aloc.data(), sin_min.data());
+            hhj::assemble_ell(Aloc.data(), FE.data(), EF.data(), ELI.data(), nE, cols.data(), A.data(), tb.nt);
+            if (schwarz) {
+                std::vector<double> diag(nE);
+                for (i64 e = 0; e < nE; ++e) diag[e] = A[5 * e];
+                // the face inverses overwrite the local blocks (memory: one #F x 9 buffer)
+                n_jacobi = hhj::face_schwarz(Aloc.data(), diag.data(), FE.data(),
+                                             fixed ? fixed->data() : nullptr, nF, Aloc.data(), tb.nt);
+                M.resize((size_t)nE * 5);
+                hhj::assemble_ell(Aloc.data(), FE.data(), EF.data(), ELI.data(), nE, nullptr, M.data(), tb.nt);
+            }
+        }
+        const size_t ne = nE;
+        nb::object Mout = nb::none();
+        if (schwarz) Mout = nb::cast(to_numpy(std::move(M), {ne, 5}));
+        return nb::make_tuple(to_numpy(std::move(cols), {ne, 5}), to_numpy(std::move(A), {ne, 5}),
+                              Mout, n_jacobi, to_numpy(std::move(sin_min), {(size_t)nF}));
+    }, "V"_a, "F"_a, "FE"_a, "EF"_a, "ELI"_a, "fixed"_a.none(), "schwarz"_a);
+
+    m.def("jump_apply", [](In<double> V, In<i64> F, In<i64> EF, In<i64> ELI, In<double> W) {
+        const i64 nF = F.shape(0), nE = EF.shape(0);
+        need(W.ndim() == 2 && W.shape(0) == V.shape(0), "jump_apply: W must be (#V, k)");
+        const int k = (int)W.shape(1);
+        std::vector<double> out((size_t)nE * k);
+        {
+            nb::gil_scoped_release nogil;
+            hhj::ThreadBudget tb(nF);
+            hhj::jump_apply(V.data(), F.data(), nF, EF.data(), ELI.data(), nE, W.data(), k, out.data(), tb.nt);
+        }
+        return to_numpy(std::move(out), {(size_t)nE, (size_t)k});
+    });
+
+    m.def("block_pcg", [](In<i64> Ap, In<std::int32_t> Ai, In<double> Ax, std::optional<In<i64>> Mp,
+                          std::optional<In<std::int32_t>> Mi, std::optional<In<double>> Mx,
+                          std::optional<In<double>> dinv, nb::ndarray<double, nb::c_contig, nb::device::cpu> R,
+                          double rtol, i64 maxiter,
+                          i64 probe_iter, double max_predicted, std::optional<In<i64>> S,
+                          std::optional<nb::callable> subdomain_solve) {
+        need(R.ndim() == 2, "block_pcg: R must be (n, k)");
+        const i64 n = R.shape(0);
+        const int k = (int)R.shape(1);
+        need(Ap.shape(0) == (size_t)n + 1, "block_pcg: indptr must have n + 1 entries");
+        need(Mp.has_value() || (dinv.has_value() && dinv->shape(0) == (size_t)n),
+             "block_pcg: need a preconditioner (CSR) or dinv (n,)");
+        std::vector<double> X((size_t)n * k);
+        hhj::PCGResult res;
+        hhj::SubdomainSolve sub;
+        if (S && subdomain_solve) {
+            sub.S = S->data();
+            sub.nS = (i64)S->shape(0);
+            for (i64 i = 0; i < sub.nS; ++i) need(sub.S[i] >= 0 && sub.S[i] < n, "block_pcg: S index out of range");
+            const size_t nS = sub.nS, kk = k;
+            nb::callable fn = *subdomain_solve;
+            sub.solve = [fn, nS, kk](const double* rS, double* zS) {
+                nb::gil_scoped_acquire gil;
+                // rS is a scratch buffer: writable, so that solvers taking writable input accept it
+                nb::ndarray<nb::numpy, double> a(const_cast<double*>(rS), {nS, kk});
+                nb::ndarray<nb::numpy, double> b(zS, {nS, kk});
+                // reference policy: the callee writes into zS itself (no copies)
+                fn(nb::cast(a, nb::rv_policy::reference), nb::cast(b, nb::rv_policy::reference));
+            };
+        }
+        {
+            nb::gil_scoped_release nogil;
+            hhj::ThreadBudget tb(n);
+            res = hhj::block_pcg(n, k, Ap.data(), Ai.data(), Ax.data(),
+                                 Mp ? Mp->data() : nullptr, Mp ? Mi->data() : nullptr,
+                                 Mp ? Mx->data() : nullptr, dinv ? dinv->data() : nullptr,
+                                 R.data(), X.data(), rtol, maxiter, probe_iter, max_predicted, tb.nt,
+                                 sub.nS ? &sub : nullptr);
+        }
+        return nb::make_tuple(to_numpy(std::move(X), {(size_t)n, (size_t)k}), res.iterations, res.status,
+                              res.relres);
+    });
+
+    m.def("shape_operator_faces", [](In<double> V, In<i64> F, In<i64> FE, In<double> s) {
+        const i64 nF = F.shape(0);
+        need(s.ndim() == 2 && s.shape(1) == 3, "shape_operator_faces: s must be (#E, 3)");
+        std::vector<double> S((size_t)nF * 9);
+        {
+            nb::gil_scoped_release nogil;
+            hhj::ThreadBudget tb(nF);
+            hhj::shape_operator_faces(V.data(), F.data(), FE.data(), nF, s.data(), S.data(), tb.nt);
+        }
+        return to_numpy(std::move(S), {(size_t)nF, 3, 3});
+    });
+
+    m.def("face_tensors", [](In<double> V, In<i64> F, In<i64> FE, In<double> s) {
+        const i64 nF = F.shape(0);
+        need(s.ndim() == 2, "face_tensors: s must be (#E, k)");
+        const int k = (int)s.shape(1);
+        std::vector<double> H((size_t)nF * k * 9);
+        {
+            nb::gil_scoped_release nogil;
+            hhj::ThreadBudget tb(nF);
+            hhj::face_tensors(V.data(), F.data(), FE.data(), nF, s.data(), k, H.data(), tb.nt);
+        }
+        return to_numpy(std::move(H), {(size_t)nF, (size_t)k, 3, 3});
+    });
+
+    m.def("lumped_vertex_recovery", [](In<double> V, In<i64> F, In<double> S, In<double> N) {
+        const i64 nF = F.shape(0), nV = V.shape(0);
+        need(S.shape(0) == (size_t)nF && N.shape(0) == (size_t)nV, "lumped_vertex_recovery: shapes");
+        std::vector<double> Sv((size_t)nV * 9);
+        {
+            nb::gil_scoped_release nogil;
+            hhj::ThreadBudget tb(0);
+            hhj::lumped_vertex_recovery(V.data(), F.data(), nF, nV, S.data(), N.data(), Sv.data());
+        }
+        return to_numpy(std::move(Sv), {(size_t)nV, 3, 3});
+    });
+
+    m.def("principal_2x2", [](In<double> S, In<double> N) {
+        const i64 n = N.shape(0);
+        need(S.shape(0) == (size_t)n, "principal_2x2: shapes");
+        std::vector<double> PD1((size_t)n * 3), PD2((size_t)n * 3), PV1(n), PV2(n);
+        {
+            nb::gil_scoped_release nogil;
+            hhj::ThreadBudget tb(n);
+            hhj::principal_2x2(S.data(), N.data(), n, PD1.data(), PD2.data(), PV1.data(), PV2.data(), tb.nt);
+        }
+        const size_t nn = n;
+        return nb::make_tuple(to_numpy(std::move(PD1), {nn, 3}), to_numpy(std::move(PD2), {nn, 3}),
+                              to_numpy(std::move(PV1), {nn}), to_numpy(std::move(PV2), {nn}));
+    });
+}

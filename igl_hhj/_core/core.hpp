@@ -1,0 +1,133 @@
+// igl_hhj compiled core: declarations shared by the kernels and the bindings.
+//
+// Conventions (igl_hhj/mesh.py, shared/design/hhj_lowest_order.md):
+//   edge i of face T is opposite corner i and runs x_{i+1} -> x_{i+2};
+//   t_i = unit edge vector, nu = unit face normal of (x1-x0)x(x2-x0),
+//   n_i = t_i x nu (outward conormal), grad lambda_i = -l_i n_i / (2|T|).
+// No hidden state: every kernel reads its inputs and writes caller-owned outputs.
+// Arrays are row-major (C-contiguous) float64 / int64.
+#pragma once
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#ifdef IGL_HHJ_OPENMP
+#include <omp.h>
+#endif
+
+namespace hhj {
+
+using i64 = std::int64_t;
+
+// ------------------------------------------------------------------ threads
+// Number of threads a kernel may use.  One call at a time gets all OpenMP
+// threads; a call made while another igl_hhj kernel is running (several Python
+// threads, the GIL released) runs single-threaded, so N Python threads never
+// start N x #cores OpenMP threads.  Small problems run single-threaded.
+struct ThreadBudget {
+    static std::atomic<int>& active() { static std::atomic<int> a{0}; return a; }
+    int nt = 1;
+    explicit ThreadBudget(i64 work) {
+        int prev = active().fetch_add(1);
+#ifdef IGL_HHJ_OPENMP
+        nt = (prev == 0 && work >= 20000) ? omp_get_max_threads() : 1;
+#else
+        (void)prev; (void)work;
+#endif
+    }
+    ~ThreadBudget() { active().fetch_sub(1); }
+};
+
+// Reductions use this fixed chunk size: partial sums per chunk, then a serial
+// sum over chunks, so results do not depend on the thread count.
+constexpr i64 CHUNK = 2048;
+
+// ------------------------------------------------------------------ geometry
+struct FaceGeom {
+    double t[3][3];   // unit edge vectors t_i
+    double n[3][3];   // unit outward conormals n_i
+    double l[3];      // edge lengths l_i
+    double nu[3];     // unit face normal
+    double dbl;       // twice the area |(x1-x0)x(x2-x0)|
+};
+
+inline void cross3(const double* a, const double* b, double* c) {
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+inline double dot3(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+// Face geometry of face f of (V, F), same formulas as mesh.py's properties.
+inline void face_geom(const double* V, const i64* F, i64 f, FaceGeom& g) {
+    const double* x[3] = {V + 3 * F[3 * f], V + 3 * F[3 * f + 1], V + 3 * F[3 * f + 2]};
+    double e1[3], e2[3], c[3];
+    for (int k = 0; k < 3; ++k) { e1[k] = x[1][k] - x[0][k]; e2[k] = x[2][k] - x[0][k]; }
+    cross3(e1, e2, c);
+    g.dbl = std::sqrt(dot3(c, c));
+    for (int k = 0; k < 3; ++k) g.nu[k] = c[k] / g.dbl;
+    for (int i = 0; i < 3; ++i) {
+        const double* a = x[(i + 1) % 3];
+        const double* b = x[(i + 2) % 3];
+        double ev[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        g.l[i] = std::sqrt(dot3(ev, ev));
+        for (int k = 0; k < 3; ++k) g.t[i][k] = ev[k] / g.l[i];
+        cross3(g.t[i], g.nu, g.n[i]);
+    }
+}
+
+// ------------------------------------------------------------------ kernels
+// mesh_kernels.cpp
+struct Topology {
+    std::vector<i64> edges;        // (#E, 2) (min, max), lexicographic order (= igl uE order)
+    std::vector<i64> face_edges;   // (#F, 3)
+    std::vector<i64> count;        // (#E,)
+    std::vector<i64> edge_faces;   // (#E, 2), -1 = none
+    std::vector<i64> local_index;  // (#E, 2), -1 = none
+    std::vector<double> sign;      // (#F, 3) +-1
+    i64 n_edges = 0;
+};
+void topology(const i64* F, i64 nF, i64 nV, Topology& out);
+void edge_morton_order(const double* V, i64 nV, const i64* E, i64 nE, i64* perm);
+
+// hhj_kernels.cpp
+void local_mass(const double* V, const i64* F, i64 nF, double* Aloc, double* sin_min = nullptr);
+void assemble_ell(const double* Aloc, const i64* FE, const i64* EF, const i64* ELI, i64 nE,
+                  std::int32_t* cols, double* vals, int nt);
+i64 face_schwarz(const double* Aloc, const double* diag, const i64* FE, const unsigned char* fixed,
+                 i64 nF, double* inv, int nt);
+void jump_apply(const double* V, const i64* F, i64 nF, const i64* EF, const i64* ELI, i64 nE,
+                const double* W, int k, double* out, int nt);
+void shape_operator_faces(const double* V, const i64* F, const i64* FE, i64 nF,
+                          const double* s, double* S, int nt);
+void face_tensors(const double* V, const i64* F, const i64* FE, i64 nF,
+                  const double* s, int k, double* H, int nt);
+void lumped_vertex_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S,
+                            const double* N, double* Sv);
+void principal_2x2(const double* S, const double* N, i64 n, double* PD1, double* PD2,
+                   double* PV1, double* PV2, int nt);
+
+// pcg.cpp
+struct PCGResult {
+    i64 iterations = 0;
+    int status = 0;              // 0 converged, 1 iteration cap, 2 stopped early (slow)
+    std::vector<double> relres;  // per column
+};
+// Optional second level of the preconditioner: z += R_S^T C (R_S r) on the index set S,
+// C given as a function (rS (nS,k) -> zS (nS,k)), e.g. an exact sparse solve.
+struct SubdomainSolve {
+    const i64* S = nullptr;
+    i64 nS = 0;
+    std::function<void(const double*, double*)> solve;
+};
+PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const double* Ax,
+                    const i64* Mp, const std::int32_t* Mi, const double* Mx, const double* dinv,
+                    double* R, double* X, double rtol, i64 maxiter,
+                    i64 probe_iter, double max_predicted, int nt,
+                    const SubdomainSolve* sub = nullptr);
+
+}  // namespace hhj

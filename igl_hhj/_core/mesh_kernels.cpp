@@ -1,0 +1,135 @@
+// Mesh topology in one pass (counting sort of the 3 #F half-edges by their
+// smaller vertex, then by the larger): unique edges, face->edge, edge->face,
+// incidence counts and half-edge signs, in the conventions of igl_hhj/mesh.py.
+#include <algorithm>
+#include <utility>
+
+#include "core.hpp"
+
+namespace hhj {
+
+// topology: F (#F,3) -> edges (#E,2) lexicographic (min,max) pairs (the order of
+// igl.unique_edge_map's uE), face_edges (#F,3) (edge opposite corner i),
+// count (#E,), edge_faces / local_index (#E,2) (column 0: the face whose
+// half-edge runs min->max), sign (#F,3) (+1 where the half-edge x_{i+1}->x_{i+2}
+// runs min->max).  On non-manifold edges (count > 2) the last faces win.
+void topology(const i64* F, i64 nF, i64 nV, Topology& T) {
+    const i64 nH = 3 * nF;
+    std::vector<i64> start(nV + 1, 0), lo(nH), hikey(nH);
+    for (i64 f = 0; f < nF; ++f)
+        for (int i = 0; i < 3; ++i) {
+            const i64 a = F[3 * f + (i + 1) % 3], b = F[3 * f + (i + 2) % 3];
+            const i64 h = 3 * f + i;
+            lo[h] = a < b ? a : b;
+            hikey[h] = a < b ? b : a;
+            ++start[lo[h] + 1];
+        }
+    for (i64 v = 0; v < nV; ++v) start[v + 1] += start[v];
+    std::vector<i64> order(nH), fill(start.begin(), start.end() - 1);
+    for (i64 h = 0; h < nH; ++h) order[fill[lo[h]]++] = h;
+    // sort each bucket by (hi, h): buckets are small (vertex valence), insertion sort;
+    // h ascending within a bucket already (counting sort is stable)
+    for (i64 v = 0; v < nV; ++v) {
+        i64* b = order.data() + start[v];
+        const i64 m = start[v + 1] - start[v];
+        if (m > 32) {
+            std::stable_sort(b, b + m, [&](i64 x, i64 y) { return hikey[x] < hikey[y]; });
+            continue;
+        }
+        for (i64 p = 1; p < m; ++p) {
+            const i64 h = b[p], key = hikey[h];
+            i64 q = p - 1;
+            while (q >= 0 && hikey[b[q]] > key) { b[q + 1] = b[q]; --q; }
+            b[q + 1] = h;
+        }
+    }
+    T.face_edges.assign(nH, 0);
+    T.sign.assign(nH, 0.0);
+    T.edges.clear();
+    T.edges.reserve(nH);  // ~ #E * 2 = 2/3 nH * 2
+    i64 nE = 0, prev_lo = -1, prev_hi = -1;
+    for (i64 v = 0; v < nV; ++v) {
+        for (i64 p = start[v]; p < start[v + 1]; ++p) {
+            const i64 h = order[p];
+            const i64 hi = hikey[h];
+            if (v != prev_lo || hi != prev_hi) {
+                T.edges.push_back(v);
+                T.edges.push_back(hi);
+                prev_lo = v; prev_hi = hi;
+                ++nE;
+            }
+            T.face_edges[h] = nE - 1;
+            const i64 f = h / 3, i = h % 3;
+            T.sign[h] = (F[3 * f + (i + 1) % 3] == v) ? 1.0 : -1.0;
+        }
+    }
+    T.n_edges = nE;
+    T.count.assign(nE, 0);
+    T.edge_faces.assign(2 * nE, -1);
+    T.local_index.assign(2 * nE, -1);
+    for (i64 h = 0; h < nH; ++h) {  // ascending (f, i): the last write wins, as in numpy
+        const i64 e = T.face_edges[h];
+        ++T.count[e];
+        const int col = T.sign[h] < 0 ? 1 : 0;
+        T.edge_faces[2 * e + col] = h / 3;
+        T.local_index[2 * e + col] = h % 3;
+    }
+}
+
+}  // namespace hhj
+
+namespace hhj {
+
+namespace {
+inline std::uint64_t spread3(std::uint64_t x) {  // 21 bits -> every third bit
+    x &= 0x1fffffULL;
+    x = (x | x << 32) & 0x1f00000000ffffULL;
+    x = (x | x << 16) & 0x1f0000ff0000ffULL;
+    x = (x | x << 8) & 0x100f00f00f00f00fULL;
+    x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+    x = (x | x << 2) & 0x1249249249249249ULL;
+    return x;
+}
+}  // namespace
+
+// edge_morton_order: perm (#E,) listing the edges by the Morton (Z-order) code of their
+// midpoints (ties by index): a memory-local numbering for the solver's sparse sweeps.
+void edge_morton_order(const double* V, i64 nV, const i64* E, i64 nE, i64* perm) {
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (i64 v = 0; v < nV; ++v)
+        for (int a = 0; a < 3; ++a) { lo[a] = std::min(lo[a], V[3 * v + a]); hi[a] = std::max(hi[a], V[3 * v + a]); }
+    double scale = 0.0;
+    for (int a = 0; a < 3; ++a) scale = std::max(scale, hi[a] - lo[a]);
+    scale = scale > 0 ? 2097151.0 / scale : 0.0;
+    std::vector<std::uint64_t> key(nE), key2(nE);
+    std::vector<i64> idx(nE), idx2(nE);
+    for (i64 e = 0; e < nE; ++e) {
+        std::uint64_t code = 0;
+        for (int a = 0; a < 3; ++a) {
+            const double mid = 0.5 * (V[3 * E[2 * e] + a] + V[3 * E[2 * e + 1] + a]);
+            double q = (mid - lo[a]) * scale;
+            q = q < 0 ? 0 : (q > 2097151.0 ? 2097151.0 : q);
+            code |= spread3((std::uint64_t)q) << a;
+        }
+        key[e] = code;
+        idx[e] = e;
+    }
+    // LSD radix sort, 16-bit digits over the 63-bit codes (stable: ties keep index order)
+    std::vector<i64> cnt(65537);
+    for (int pass = 0; pass < 4; ++pass) {
+        const int shift = 16 * pass;
+        std::fill(cnt.begin(), cnt.end(), 0);
+        for (i64 e = 0; e < nE; ++e) ++cnt[((key[e] >> shift) & 0xffff) + 1];
+        for (int d = 0; d < 65536; ++d) cnt[d + 1] += cnt[d];
+        for (i64 e = 0; e < nE; ++e) {
+            const i64 dst = cnt[(key[e] >> shift) & 0xffff]++;
+            key2[dst] = key[e];
+            idx2[dst] = idx[e];
+        }
+        key.swap(key2);
+        idx.swap(idx2);
+    }
+    for (i64 e = 0; e < nE; ++e) perm[e] = idx[e];
+}
+
+}  // namespace hhj

@@ -1,0 +1,225 @@
+// Fused block preconditioned conjugate gradients: k independent CG recurrences
+// (e.g. the 3 coordinate right-hand sides of eq. 5.14) sharing every sweep over
+// the matrix.  Deterministic reductions: per-chunk partial sums over fixed
+// CHUNK-row blocks, then a serial sum over the chunks.
+#include <algorithm>
+#include <cmath>
+
+#include "core.hpp"
+
+namespace hhj {
+
+namespace {
+struct Partials {
+    i64 nch;
+    int k;
+    std::vector<double> buf;
+    Partials(i64 n, int k_) : nch((n + CHUNK - 1) / CHUNK), k(k_), buf((size_t)std::max<i64>(nch, 1) * k_) {}
+    void reduce(std::vector<double>& out) const {
+        std::fill(out.begin(), out.end(), 0.0);
+        for (i64 c = 0; c < nch; ++c)
+            for (int j = 0; j < k; ++j) out[j] += buf[(size_t)c * k + j];
+    }
+};
+
+// y = Op x for CSR (p, i, v) or, without it, y = dinv .* x;  partial sums of d.y per chunk.
+// K = number of columns known at compile time (0: runtime k), local accumulators.
+template <int K>
+void apply_and_dot_k(i64 n, int kr, const i64* p, const std::int32_t* idx, const double* v, const double* dinv,
+                     const double* x, double* y, const double* d, Partials& P, int nt) {
+    const int k = K ? K : kr;
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+    for (i64 c = 0; c < P.nch; ++c) {
+        const i64 r0 = c * CHUNK, r1 = std::min(n, r0 + CHUNK);
+        double acc[16] = {0};
+        for (i64 r = r0; r < r1; ++r) {
+            double yr[16];
+            if (p) {
+                for (int j = 0; j < k; ++j) yr[j] = 0.0;
+                const i64 q1 = p[r + 1];
+                for (i64 q = p[r]; q < q1; ++q) {
+                    const double a = v[q];
+                    const double* xc = x + (i64)idx[q] * k;
+                    for (int j = 0; j < k; ++j) yr[j] += a * xc[j];
+                }
+            } else {
+                const double di = dinv[r];
+                for (int j = 0; j < k; ++j) yr[j] = di * x[r * k + j];
+            }
+            for (int j = 0; j < k; ++j) {
+                y[r * k + j] = yr[j];
+                acc[j] += d[r * k + j] * yr[j];
+            }
+        }
+        for (int j = 0; j < k; ++j) P.buf[(size_t)c * k + j] = acc[j];
+    }
+}
+
+void apply_and_dot(i64 n, int k, const i64* p, const std::int32_t* idx, const double* v, const double* dinv,
+                   const double* x, double* y, const double* d, Partials& P, int nt) {
+    switch (k) {
+        case 1: apply_and_dot_k<1>(n, k, p, idx, v, dinv, x, y, d, P, nt); break;
+        case 3: apply_and_dot_k<3>(n, k, p, idx, v, dinv, x, y, d, P, nt); break;
+        default: apply_and_dot_k<0>(n, k, p, idx, v, dinv, x, y, d, P, nt);
+    }
+}
+
+// X += alpha p; r -= alpha q; partial sums of r.r per chunk
+template <int K>
+void update_k(i64 n, int kr, const double* alpha_in, double* X, double* r, const double* p,
+              const double* q, Partials& P, int nt) {
+    const int k = K ? K : kr;
+    double alpha[16];
+    for (int j = 0; j < k; ++j) alpha[j] = alpha_in[j];
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+    for (i64 c = 0; c < P.nch; ++c) {
+        const i64 r0 = c * CHUNK, r1 = std::min(n, r0 + CHUNK);
+        double acc[16] = {0};
+        for (i64 i = r0; i < r1; ++i)
+            for (int j = 0; j < k; ++j) {
+                const size_t s = (size_t)i * k + j;
+                X[s] += alpha[j] * p[s];
+                const double rs = r[s] - alpha[j] * q[s];
+                r[s] = rs;
+                acc[j] += rs * rs;
+            }
+        for (int j = 0; j < k; ++j) P.buf[(size_t)c * k + j] = acc[j];
+    }
+}
+
+void update(i64 n, int k, const double* alpha, double* X, double* r, const double* p, const double* q,
+            Partials& P, int nt) {
+    switch (k) {
+        case 1: update_k<1>(n, k, alpha, X, r, p, q, P, nt); break;
+        case 3: update_k<3>(n, k, alpha, X, r, p, q, P, nt); break;
+        default: update_k<0>(n, k, alpha, X, r, p, q, P, nt);
+    }
+}
+}  // namespace
+
+// block_pcg: solve A X = R, A (n x n) SPD in CSR (Ap, Ai, Ax), R and X (n, k) row-major
+// (R is overwritten by the final residual),
+// preconditioner M in CSR (Mp, Mi, Mx) or, with Mp == nullptr, Jacobi dinv (n,).
+// Column j stops when |r_j| <= rtol |R_j|.  Every probe_iter iterations (0: never) the
+// iterations still needed are extrapolated from the mean rate so far; above
+// max_predicted the solve stops early (status 2) so the caller can switch solvers.
+// Status 3: breakdown (p.Ap <= 0 or the residual grew 1e4-fold: A numerically singular).
+PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const double* Ax,
+                    const i64* Mp, const std::int32_t* Mi, const double* Mx, const double* dinv,
+                    double* R, double* X, double rtol, i64 maxiter,
+                    i64 probe_iter, double max_predicted, int nt, const SubdomainSolve* sub) {
+    if (k > 16) throw std::invalid_argument("block_pcg: at most 16 right-hand sides per call");
+    PCGResult res;
+    res.relres.assign(k, 0.0);
+    double* r = R;  // R becomes the residual (caller's scratch: no copy of n x k)
+    std::vector<double> z((size_t)n * k), p((size_t)n * k), q((size_t)n * k);
+    std::fill(X, X + (size_t)n * k, 0.0);
+    Partials P(n, k);
+    std::vector<double> bb(k), rr(k), rz(k), rz_new(k), pq(k), alpha(k), beta(k), tol2(k);
+    std::vector<char> active(k);
+    // bb = R.R (Jacobi-free: use apply_and_dot with the identity is wasteful; direct chunked dot)
+    auto chunk_dot = [&](const double* a, const double* b, std::vector<double>& out) {
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+        for (i64 c = 0; c < P.nch; ++c) {
+            const i64 r0 = c * CHUNK, r1 = std::min(n, r0 + CHUNK);
+            double acc[16] = {0};
+            for (i64 i = r0; i < r1; ++i)
+                for (int j = 0; j < k; ++j) acc[j] += a[i * k + j] * b[i * k + j];
+            for (int j = 0; j < k; ++j) P.buf[(size_t)c * k + j] = acc[j];
+        }
+        P.reduce(out);
+    };
+    chunk_dot(R, R, bb);
+    bool any = false;
+    for (int j = 0; j < k; ++j) {
+        tol2[j] = rtol * rtol * bb[j];
+        rr[j] = bb[j];
+        active[j] = rr[j] > tol2[j];
+        any = any || active[j];
+    }
+    if (!any || n == 0) return res;
+    std::vector<double> rS, zS;
+    if (sub && sub->nS > 0) { rS.resize((size_t)sub->nS * k); zS.resize((size_t)sub->nS * k); }
+    // z = M r (+ R_S^T C R_S r), out = r.z; the second level's share of r.z is summed
+    // serially over S in a fixed order (deterministic).
+    auto precondition = [&](std::vector<double>& out) {
+        apply_and_dot(n, k, Mp, Mi, Mx, dinv, r, z.data(), r, P, nt);
+        P.reduce(out);
+        if (rS.empty()) return;
+        for (i64 i = 0; i < sub->nS; ++i)
+            for (int j = 0; j < k; ++j) rS[(size_t)i * k + j] = r[(size_t)sub->S[i] * k + j];
+        sub->solve(rS.data(), zS.data());
+        for (i64 i = 0; i < sub->nS; ++i)
+            for (int j = 0; j < k; ++j) {
+                const size_t s = (size_t)sub->S[i] * k + j;
+                z[s] += zS[(size_t)i * k + j];
+                out[j] += rS[(size_t)i * k + j] * zS[(size_t)i * k + j];
+            }
+    };
+    precondition(rz);
+    std::copy(z.begin(), z.end(), p.begin());
+    res.status = 1;
+    for (i64 it = 1; it <= maxiter; ++it) {
+        apply_and_dot(n, k, Ap, Ai, Ax, nullptr, p.data(), q.data(), p.data(), P, nt);
+        P.reduce(pq);
+        bool breakdown = false;
+        for (int j = 0; j < k; ++j) {
+            alpha[j] = active[j] ? rz[j] / pq[j] : 0.0;
+            breakdown = breakdown || (active[j] && !(pq[j] > 0.0 && std::isfinite(alpha[j])));
+        }
+        if (breakdown) { res.status = 3; res.iterations = it; break; }
+        update(n, k, alpha.data(), X, r, p.data(), q.data(), P, nt);
+        P.reduce(rr);
+        res.iterations = it;
+        any = false;
+        for (int j = 0; j < k; ++j) {
+            active[j] = active[j] && rr[j] > tol2[j];
+            any = any || active[j];
+            // divergence in floating point (A numerically singular): residual up 1e4x
+            breakdown = breakdown || !std::isfinite(rr[j]) || rr[j] > 1e8 * bb[j];
+        }
+        if (breakdown) { res.status = 3; break; }
+        if (!any) { res.status = 0; break; }
+        if (probe_iter > 0 && it % probe_iter == 0 && rtol > 0) {
+            double worst = 0.0;
+            for (int j = 0; j < k; ++j)
+                if (active[j] && bb[j] > 0) worst = std::max(worst, std::sqrt(rr[j] / bb[j]));
+            if (worst > 0 && worst < 1) {
+                const double predicted = (double)it * std::log(rtol) / std::log(worst);
+                if (predicted > max_predicted) { res.status = 2; break; }
+            } else if (worst >= 1) {
+                res.status = 2; break;
+            }
+        }
+        precondition(rz_new);
+        for (int j = 0; j < k; ++j) {
+            beta[j] = active[j] ? rz_new[j] / rz[j] : 0.0;
+            rz[j] = rz_new[j];
+        }
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+        for (i64 c = 0; c < P.nch; ++c) {
+            const i64 r0 = c * CHUNK, r1 = std::min(n, r0 + CHUNK);
+            double b[16];
+            for (int j = 0; j < k; ++j) b[j] = beta[j];
+            double* pp = p.data();
+            const double* zz = z.data();
+            for (i64 i = r0; i < r1; ++i)
+                for (int j = 0; j < k; ++j) {
+                    const size_t s = (size_t)i * k + j;
+                    pp[s] = zz[s] + b[j] * pp[s];
+                }
+        }
+    }
+    for (int j = 0; j < k; ++j) res.relres[j] = bb[j] > 0 ? std::sqrt(rr[j] / bb[j]) : 0.0;
+    return res;
+}
+
+}  // namespace hhj

@@ -1,0 +1,270 @@
+"""Thin Python face of the compiled core ``igl_hhj._hhj_core`` (C++17, nanobind).
+
+This is the only module that imports the extension.  Every function checks and
+coerces its arrays once (C-contiguous float64 / int64, shapes) and hands them to
+one C++ kernel; the kernels have no hidden state and release the GIL.  The
+readable numpy reference of each kernel is named in its docstring; tests
+(``tests/test_core.py``) compare the two.
+
+Threads: a kernel uses all OpenMP threads (``OMP_NUM_THREADS``) when it is the
+only igl_hhj kernel running, and one thread when called while another one runs
+(several Python threads), so concurrent callers never oversubscribe the cores.
+Reductions use a fixed chunking, so results are bit-identical for any thread
+count.
+"""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+# Idle OpenMP threads sleep instead of spinning (libgomp reads this when the extension
+# loads it).  Measured on the shared 2-core machine (load 8): with the default spinning,
+# two threads made the drop-in 1.8x slower than one; passive waiting made them equal.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
+try:
+    from . import _hhj_core as _core
+except ImportError as exc:  # pragma: no cover - exercised only on a broken install
+    raise ImportError(
+        "igl_hhj's compiled core (igl_hhj._hhj_core) is missing or failed to load "
+        f"({exc}). It is built when igl_hhj is installed: reinstall on a machine with a "
+        "C++17 compiler and cmake, e.g. `pip install --force-reinstall --no-cache-dir .` "
+        "from the igl_hhj source tree (scikit-build-core and nanobind come from PyPI)."
+    ) from exc
+
+__all__ = [
+    "topology", "hhj_system", "jump_apply", "block_pcg", "shape_operator_faces",
+    "face_tensors", "lumped_vertex_recovery", "principal_2x2", "max_threads",
+    "set_num_threads", "ell_indptr", "edge_morton_order",
+]
+
+
+def _f64(a, name, shape_tail=None):
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    if shape_tail is not None and a.shape[1:] != tuple(shape_tail):
+        raise ValueError(f"{name} must have shape (n, {', '.join(map(str, shape_tail))}), got {a.shape}")
+    return a
+
+
+def _i64(a):
+    return np.ascontiguousarray(a, dtype=np.int64)
+
+
+def _i32(a):
+    return np.ascontiguousarray(a, dtype=np.int32)
+
+
+_USER_THREADS = _core.max_threads()     # OMP_NUM_THREADS or the core count
+# Run single-threaded while the machine is already busy (1-minute load average ≥ the
+# number of cores): extra threads then only queue behind other processes.  Results do
+# not depend on the thread count (fixed-chunk reductions).
+ADAPT_TO_LOAD = True
+
+
+def max_threads():
+    """Number of OpenMP threads a kernel may use (1 without OpenMP)."""
+    return _core.max_threads()
+
+
+def set_num_threads(n):
+    """Set the OpenMP thread count of igl_hhj's kernels (``omp_set_num_threads``)."""
+    global _USER_THREADS
+    _USER_THREADS = max(1, int(n))
+    _core.set_num_threads(_USER_THREADS)
+
+
+def _threads():
+    """Apply the thread policy for the next kernel call (calling thread only)."""
+    n = _USER_THREADS
+    if ADAPT_TO_LOAD and n > 1:
+        try:
+            if os.getloadavg()[0] >= (os.cpu_count() or 1):
+                n = 1
+        except OSError:  # pragma: no cover - no load average on this platform
+            pass
+    _core.set_num_threads(n)
+
+
+def topology(F, n_vertices):
+    """Unique edges and incidence maps of ``F`` in one pass.
+
+    Reference: ``igl.unique_edge_map`` plus the numpy properties of
+    :class:`igl_hhj.mesh.TriangleMesh`.
+
+    Returns
+    -------
+    edges : (#E, 2) int64, ``(min, max)`` vertex pairs in lexicographic order
+        (the order of ``igl.unique_edge_map``'s ``uE``).
+    face_edges : (#F, 3) int64, the edge opposite corner i of face f.
+    count : (#E,) int64, faces per edge.
+    edge_faces, local_index : (#E, 2) int64, faces (column 0: the one whose
+        half-edge runs min → max) and the edge's local index there; -1 for none.
+    sign : (#F, 3) float64, +1 where the half-edge ``x_{i+1} → x_{i+2}`` runs min → max.
+    """
+    F = _i64(F)
+    if F.ndim != 2 or F.shape[1] != 3:
+        raise ValueError(f"F must have shape (#F, 3), got {F.shape}")
+    return _core.topology(F, int(n_vertices))
+
+
+def edge_morton_order(mesh):
+    """(#E,) int64 permutation listing the edges by the Morton (Z-order) code of their
+    midpoints: a cache-friendly numbering for the solver (the lexicographic edge order
+    scatters neighbouring edges across memory)."""
+    return _core.edge_morton_order(mesh.V, _i64(mesh.edges))
+
+
+def hhj_system(mesh, fixed=None, schwarz=True, topology=None):
+    """Assembled HHJ matrix A and its face-Schwarz preconditioner M, fixed-width rows.
+
+    Reference: :func:`igl_hhj.hhj.mass_matrix` and
+    :func:`igl_hhj.hhj.face_schwarz_preconditioner`.
+
+    Parameters
+    ----------
+    mesh : TriangleMesh
+    fixed : (#E,) bool, optional
+        Fixed DOFs: M gets zero rows/columns there (A is returned unmasked).
+    schwarz : bool
+        Also build M.
+    topology : (face_edges, edge_faces, edge_local_index), optional
+        A renumbering of the mesh's edge maps (e.g. by :func:`edge_morton_order`);
+        rows, columns and ``fixed`` are then in that numbering.
+
+    Returns
+    -------
+    cols : (#E, 5) int32, column of each slot (slot 0 = the diagonal; unused
+        slots point at the diagonal with value 0)
+    A : (#E, 5) float64, ``A[e, e'] = Σ_T |T| φ_e : φ_e'`` (Walker eq. 5.14)
+    M : (#E, 5) float64 or None, ``Σ_T R_Tᵀ (R_T A R_Tᵀ)⁻¹ R_T`` (same columns)
+    n_jacobi : int, faces whose block was numerically singular and got Jacobi instead
+    sin_min_angle : (#F,) float64, sine of each face's smallest angle,
+        ``2|T| l_min / (l_0 l_1 l_2)``
+    """
+    fx = None if fixed is None else np.ascontiguousarray(fixed, dtype=np.uint8)
+    FE, EF, ELI = topology if topology is not None else \
+        (mesh.face_edges, mesh.edge_faces, mesh.edge_local_index)
+    FE, EF, ELI = _i64(FE), _i64(EF), _i64(ELI)
+    nE = mesh.n_edges
+    if FE.shape != (mesh.n_faces, 3) or EF.shape != (nE, 2) or ELI.shape != (nE, 2) \
+            or (fx is not None and fx.shape != (nE,)):
+        raise ValueError("hhj_system: topology arrays do not match the mesh")
+    _threads()
+    return _core.hhj_system(mesh.V, mesh.F, FE, EF, ELI, fx, bool(schwarz))
+
+
+def jump_apply(mesh, W):
+    """``B W`` (#E, k) for P1 vertex values ``W`` (#V, k); reference :func:`igl_hhj.hhj.jump_matrix`."""
+    W = _f64(W, "W")
+    if W.ndim != 2 or W.shape[0] != mesh.n_vertices:
+        raise ValueError(f"W must have shape ({mesh.n_vertices}, k), got {W.shape}")
+    _threads()
+    return _core.jump_apply(mesh.V, mesh.F, _i64(mesh.edge_faces), _i64(mesh.edge_local_index), W)
+
+
+def ell_indptr(n, width=5):
+    """CSR row pointer of a fixed-width row format."""
+    return np.arange(0, width * n + 1, width, dtype=np.int64)
+
+
+def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,
+              probe_iter=0, max_predicted=np.inf, subdomain=None, subdomain_solve=None,
+              overwrite_R=False):
+    """Fused block PCG on all columns of ``R`` (n, k ≤ 16) for a CSR matrix.
+
+    Column indices travel as int32 (memory bandwidth: the sweeps are memory-bound).
+    Reference: :func:`igl_hhj.hhj._block_pcg`.  Preconditioner: ``M`` =
+    ``(indptr, indices, data)`` of a CSR matrix, else Jacobi with ``dinv``; with
+    ``subdomain`` (int64 indices S) and ``subdomain_solve(r_S, z_S)`` (writes
+    ``z_S = C r_S`` into its second argument, (|S|, k) float64) a second level
+    ``z += R_Sᵀ C R_S r`` is added (e.g. an exact sparse solve on the DOFs of
+    badly shaped faces).
+
+    Returns
+    -------
+    X : (n, k) float64
+    iterations : int
+    status : int, 0 converged, 1 reached maxiter, 2 stopped early because the
+        extrapolated iteration count exceeded ``max_predicted`` (checked every
+        ``probe_iter`` iterations), 3 breakdown (``pᵀAp ≤ 0`` or the residual grew
+        10⁴-fold: the matrix is numerically singular or not SPD)
+    relres : list of float, final relative residual per column
+    """
+    R = np.asarray(R, dtype=np.float64, order="C") if overwrite_R else \
+        np.array(R, dtype=np.float64, order="C", copy=True)
+    if R.ndim != 2:
+        raise ValueError(f"R must be (n, k), got {R.shape}")
+    n = R.shape[0]
+    if n >= 2 ** 31:
+        raise ValueError(f"block_pcg handles fewer than 2**31 unknowns, got {n}")
+    indptr, indices, data = _i64(indptr), _i32(indices), _f64(data, "data")
+    if indptr.shape != (n + 1,) or indices.shape != data.shape or indptr[-1] > len(indices):
+        raise ValueError("inconsistent CSR arrays for block_pcg")
+    if len(indices) and (indices.min() < 0 or indices.max() >= n):
+        raise ValueError("CSR column index out of range in block_pcg")
+    Mp = Mi = Mx = None
+    if M is not None:
+        Mp, Mi, Mx = _i64(M[0]), _i32(M[1]), _f64(M[2], "M")
+        if Mp.shape != (n + 1,) or Mi.shape != Mx.shape or (len(Mi) and (Mi.min() < 0 or Mi.max() >= n)):
+            raise ValueError("inconsistent preconditioner CSR arrays for block_pcg")
+    elif dinv is not None:
+        dinv = _f64(dinv, "dinv")
+        if dinv.shape != (n,):
+            raise ValueError(f"dinv must be ({n},), got {dinv.shape}")
+    else:
+        raise ValueError("block_pcg needs M or dinv")
+    S = None
+    if subdomain is not None:
+        S = _i64(subdomain)
+        if subdomain_solve is None or not callable(subdomain_solve):
+            raise TypeError("subdomain needs a callable subdomain_solve(r_S, z_S)")
+    _threads()
+    return _core.block_pcg(indptr, indices, data, Mp, Mi, Mx, dinv, R, float(rtol), int(maxiter),
+                           int(probe_iter), float(max_predicted), S,
+                           subdomain_solve if S is not None else None)
+
+
+def shape_operator_faces(mesh, s):
+    """``S_h|_T = -Σ_k ν_T^k σ^k|_T`` (#F, 3, 3) from the edge DOFs ``s`` (#E, 3), Walker eq. (5.12).
+
+    Reference: :func:`igl_hhj.hhj.face_tensors` contracted with the face normals."""
+    s = _f64(s, "s", (3,))
+    _threads()
+    return _core.shape_operator_faces(mesh.V, mesh.F, _i64(mesh.face_edges), s)
+
+
+def face_tensors(mesh, s):
+    """``Σ_j s[e(f, j), k] φ_j`` (#F, k, 3, 3) for edge DOFs ``s`` (#E, k); reference :func:`igl_hhj.hhj.face_tensors`."""
+    s = _f64(s, "s")
+    if s.ndim != 2 or s.shape[0] != mesh.n_edges:
+        raise ValueError(f"s must have shape ({mesh.n_edges}, k), got {s.shape}")
+    _threads()
+    return _core.face_tensors(mesh.V, mesh.F, _i64(mesh.face_edges), s)
+
+
+def lumped_vertex_recovery(mesh, S, N):
+    """``S_v = P_v (Σ_T |T| S_T / Σ_T |T|) P_v`` (#V, 3, 3), ``P_v = I - N_v ⊗ N_v``.
+
+    Reference: :func:`igl_hhj.curvature.vertex_shape_operator` (the lumped
+    1-ring average).  ``S`` (#F, 3, 3), ``N`` (#V, 3); NaN rows for
+    unreferenced vertices."""
+    S = _f64(S, "S", (3, 3))
+    N = _f64(N, "N", (3,))
+    if S.shape[0] != mesh.n_faces or N.shape[0] != mesh.n_vertices:
+        raise ValueError("S must be (#F, 3, 3) and N (#V, 3)")
+    return _core.lumped_vertex_recovery(mesh.V, mesh.F, S, N)
+
+
+def principal_2x2(S, N):
+    """Closed-form principal curvatures/directions of tangential tensors.
+
+    Reference: the numpy ``eigh`` version,
+    :func:`igl_hhj.curvature._principal_from_shape_operator_reference`.
+    ``S`` (n, 3, 3), ``N`` (n, 3) unit normals → ``PD1, PD2`` (n, 3), ``PV1 ≥ PV2`` (n,)."""
+    S = _f64(S, "S", (3, 3))
+    N = _f64(N, "N", (3,))
+    if S.shape[0] != N.shape[0]:
+        raise ValueError(f"S and N must have the same length, got {S.shape[0]} and {N.shape[0]}")
+    _threads()
+    return _core.principal_2x2(S, N)

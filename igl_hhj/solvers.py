@@ -1,0 +1,346 @@
+"""Solver strategy for the HHJ system ``A s^k = -B X^k + g^k`` (and generic SPD systems).
+
+Three ways to solve, chosen per call:
+
+* ``"direct"``: sparse Cholesky (CHOLMOD through ``cholespy``; SuperLU when
+  cholespy is not importable), one factorisation for all right-hand sides.
+* ``"cg"``: the compiled fused block PCG (:func:`igl_hhj.kernels.block_pcg`),
+  preconditioned by a two-level method: the face-Schwarz preconditioner (exact
+  inverses of every face's 3×3 block of A) plus an exact sparse Cholesky solve on
+  the DOFs of the faces with a smallest angle below :data:`SLIVER_ANGLE` (where
+  A's ill-conditioning lives).  Without the second level, sliver meshes need
+  400–800 iterations (camelhead 811, bunny upsampled twice 417); with it 40–60.
+* ``"auto"`` (default): direct below :data:`AUTO_DIRECT_MAX` unknowns; otherwise
+  the same PCG, which checks its convergence rate every :data:`PROBE_ITER`
+  iterations and, when the extrapolated iteration count would cost more than the
+  estimated factorisation (:func:`_direct_seconds`), stops and factorises instead.
+  Above :data:`DIRECT_MAX` unknowns (memory) PCG always runs to the end.
+
+Tolerance
+---------
+``rtol`` is the relative residual ``‖r_j‖ ≤ rtol ‖R_j‖`` per right-hand side.
+The default :data:`DEFAULT_RTOL` = 1e-6 of the public curvature functions is tied to
+the discretisation error: ``python -m igl_hhj.benchmarks.speed --rtol-study`` measures
+the L2 vertex error of H against the exact surface on jittered ellipsoids (20k–328k
+faces) and Walker's sliver torus; at 1e-6 it differs from the error at 1e-12 by at
+most 0.0004 % (1e-4: up to 0.03 %, growing about 4× per refinement; 1e-3: 3.6 % at
+328k faces), for 35–50 % fewer iterations than 1e-12.  :func:`igl_hhj.hhj.solve_spd`
+keeps its own default 1e-10 (generic systems).
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import scipy.sparse as sp
+
+from . import kernels
+from .errors import SolverDidNotConverge, SolverError
+
+__all__ = ["DEFAULT_RTOL", "HHJSystem", "cholesky_solve", "pcg", "SolveInfo"]
+
+DEFAULT_RTOL = 1e-6
+# "auto": factorise without trying PCG up to this many unknowns (everything is instant there)
+AUTO_DIRECT_MAX = 3_000
+# "auto": never factorise above this many unknowns (fill and memory), PCG runs to convergence
+DIRECT_MAX = 700_000
+# "auto": PCG checks its rate this often
+PROBE_ITER = 20
+# iteration cap of "cg"
+CG_MAXITER = 5000
+# faces with a smallest angle below this (degrees) form the sliver subdomain of the
+# two-level preconditioner (exact sparse solve on their DOFs); chosen by
+# `python -m igl_hhj.benchmarks.speed --sliver-study` (0°-25° on camelhead, the bunny
+# upsampled twice, an open scan and a jittered ellipsoid: 15-20° is fastest on all four)
+SLIVER_ANGLE = 20.0
+# above this fraction of sliver DOFs the mesh is "all slivers": "auto" factorises A itself
+SLIVER_MAX_FRACTION = 0.8
+
+
+class SolveInfo(dict):
+    """What a solve did: ``solver`` ("direct"/"cg"), ``iterations``, ``seconds``, ``switched``."""
+
+
+def _direct_seconds(n):
+    """Estimated time of one sparse Cholesky factorisation + solve of the HHJ matrix (n unknowns).
+
+    Power-law fit of CHOLMOD times on this machine (single core; the "S_h direct"
+    column of ``python -m igl_hhj.benchmarks.speed``): ≈ 0.2 s at 34k unknowns
+    (camelhead), ≈ 1.4 s at 167k (bunny upsampled twice)."""
+    return 3.9e-7 * n ** 1.255
+
+
+def _pcg_iter_seconds(n, k):
+    """Estimated time of one fused PCG iteration (n unknowns, k right-hand sides);
+    ≈ 0.1 s for 7 iterations at 1.97M unknowns, k = 3, single core
+    (``python -m igl_hhj.benchmarks.speed --profile 'icosphere(8)'``: PCG 0.71 s)."""
+    return 1.2e-8 * n * (1 + k)
+
+
+def _splu_solve(A, R):
+    import scipy.sparse.linalg as spla
+    try:
+        return spla.splu(sp.csc_matrix(A)).solve(R)
+    except RuntimeError as exc:
+        raise SolverError(f"sparse LU failed: {exc}") from None
+
+
+def cholesky_solve(A, R, *, prefer_lu=False):
+    """Solve ``A X = R`` for SPD sparse A by one sparse factorisation.
+
+    Sparse Cholesky (CHOLMOD via cholespy); SuperLU (``scipy.sparse.linalg.splu``,
+    LU with partial pivoting) when cholespy is not available, when
+    ``prefer_lu`` is set (matrices known to be numerically semi-definite, e.g.
+    with faces of relative area ~1e-9) or when CHOLMOD finds the matrix not
+    numerically positive definite.  ``R`` (n,) or (n, k).  Raises
+    :class:`SolverError` when the factorisation fails or the solution is not finite."""
+    R = np.ascontiguousarray(R, dtype=np.float64)
+    n = A.shape[0]
+    if n == 0:
+        return np.zeros_like(R)
+    A = sp.csr_matrix(A)
+    if not A.has_canonical_format:
+        A = A.copy()          # sum_duplicates works in place: leave the caller's matrix alone
+        A.sum_duplicates()
+    try:
+        from cholespy import CholeskySolverD, MatrixType
+    except ImportError:  # pragma: no cover - cholespy is a dependency
+        prefer_lu = True
+    X = None
+    if not prefer_lu:
+        try:
+            solver = CholeskySolverD(n, A.indptr.astype(np.int32), A.indices.astype(np.int32),
+                                     np.ascontiguousarray(A.data), MatrixType.CSR)
+        except (ValueError, RuntimeError):
+            X = None          # not numerically positive definite: LU below
+        else:
+            X = np.empty_like(R)
+            solver.solve(R, X)
+    if X is None:
+        X = _splu_solve(A, R)
+    if not np.isfinite(X).all():
+        raise SolverError("the sparse direct solve produced non-finite values (matrix numerically singular)")
+    return X
+
+
+def pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None, probe_iter=0,
+        max_predicted=np.inf, subdomain=None, subdomain_solve=None, overwrite_R=False):
+    """Compiled block PCG on all columns of ``R`` (n, k), in groups of 16.
+
+    Returns ``(X, iterations, status, relres)`` (see :func:`igl_hhj.kernels.block_pcg`;
+    iterations / status are the worst over the groups).  ``overwrite_R`` (k ≤ 16 only):
+    R (C-contiguous float64) is used as the residual buffer and holds the final
+    residual afterwards."""
+    if R.shape[1] <= 16:
+        return kernels.block_pcg(indptr, indices, data, R, rtol=rtol, maxiter=maxiter, M=M, dinv=dinv,
+                                 probe_iter=probe_iter, max_predicted=max_predicted,
+                                 subdomain=subdomain, subdomain_solve=subdomain_solve,
+                                 overwrite_R=overwrite_R)
+    R = np.ascontiguousarray(R, dtype=np.float64)
+    X = np.empty_like(R)
+    its, statuses, relres = [0], [0], []
+    for j in range(0, R.shape[1], 16):
+        X[:, j:j + 16], it, st, rr = kernels.block_pcg(
+            indptr, indices, data, R[:, j:j + 16], rtol=rtol, maxiter=maxiter, M=M, dinv=dinv,
+            probe_iter=probe_iter, max_predicted=max_predicted, subdomain=subdomain,
+            subdomain_solve=subdomain_solve)
+        its.append(it)
+        statuses.append(st)
+        relres += list(rr)
+        if st != 0:
+            break
+    return X, max(its), max(statuses), relres
+
+
+class HHJSystem:
+    """The assembled HHJ matrix A of one mesh (compiled), ready to solve.
+
+    ``A[e, e'] = Σ_T |T| φ_e : φ_e'`` (Walker eq. 5.14) in a fixed-width row
+    format (5 slots per edge, :func:`igl_hhj.kernels.hhj_system`), with the
+    face-Schwarz preconditioner in the same format.  Fixed (simply supported)
+    DOFs become identity rows with zero right-hand side, so one square system
+    of size #E is solved whatever the boundary partition.
+
+    Parameters
+    ----------
+    mesh : TriangleMesh
+    fixed : (#E,) bool, optional
+        Fixed DOFs (their values are passed to :meth:`solve`).
+    """
+
+    def __init__(self, mesh, fixed=None):
+        self.mesh = mesh
+        n = mesh.n_edges
+        # Internally the edges are renumbered along a Morton curve (memory locality of
+        # the sparse sweeps: 5-10x faster PCG iterations than the lexicographic order).
+        self.perm = kernels.edge_morton_order(mesh)          # new -> old
+        iperm = np.empty_like(self.perm)
+        iperm[self.perm] = np.arange(n)
+        self._iperm = iperm
+        topo = (iperm[mesh.face_edges], mesh.edge_faces[self.perm], mesh.edge_local_index[self.perm])
+        fixed = None if fixed is None or not np.any(fixed) else np.asarray(fixed, dtype=bool)
+        self.fixed = None if fixed is None else fixed[self.perm]
+        self.cols, self.A_full, self.M, self.n_jacobi_faces, self.sin_min_angle = kernels.hhj_system(
+            mesh, self.fixed, True, topology=topo)
+        if self.fixed is not None:
+            A = self.A_full.copy()
+            A[self.fixed] = 0.0
+            A[self.fixed, 0] = 1.0
+            A[self.fixed[self.cols] & ~self.fixed[:, None]] = 0.0
+            self.M[self.fixed, 0] = 1.0   # r stays 0 on fixed rows, so z does too
+            self.A = A
+        else:
+            self.A = self.A_full
+        self.indptr = kernels.ell_indptr(n)
+        self._cols_flat = self.cols.ravel()              # int32 (memory-bound sweeps)
+
+    @property
+    def n(self):
+        return self.A.shape[0]
+
+    def sliver_dofs(self, angle=None):
+        """(m,) int64, internal numbering: free DOFs of the faces whose smallest angle is
+        below ``angle`` degrees (default :data:`SLIVER_ANGLE`;
+        ``sin α_min = 2|T| l_min / (l_0 l_1 l_2)``)."""
+        if angle is None:
+            angle = SLIVER_ANGLE
+        m = self.mesh
+        bad = self.sin_min_angle < np.sin(np.radians(angle))
+        S = np.zeros(self.n, dtype=bool)
+        S[self._iperm[m.face_edges[bad]].ravel()] = True
+        if self.fixed is not None:
+            S &= ~self.fixed
+        return np.flatnonzero(S)
+
+    def _two_level(self, S):
+        """Exact sparse solve on the sliver DOFs S: the subdomain_solve callable, or None
+        when A_SS cannot be factorised (numerically singular faces: face-Schwarz alone)."""
+        A = self.csr()[S][:, S].tocsr()
+        A.sum_duplicates()
+        if self.n_jacobi_faces > 0:
+            # numerically singular face blocks: LU with pivoting (CHOLMOD would refuse)
+            import scipy.sparse.linalg as spla
+            try:
+                lu = spla.splu(sp.csc_matrix(A))
+            except RuntimeError:
+                return None
+
+            def solve_lu(r, z):
+                z[...] = lu.solve(r)
+            return solve_lu
+        try:
+            from cholespy import CholeskySolverD, MatrixType
+            ch = CholeskySolverD(len(S), A.indptr.astype(np.int32), A.indices.astype(np.int32),
+                                 np.ascontiguousarray(A.data), MatrixType.CSR)
+        except (ImportError, ValueError, RuntimeError):
+            return None
+
+        def solve(r, z):
+            ch.solve(r, z)
+        return solve
+
+    def csr(self):
+        """The (masked) system matrix in the internal (Morton) numbering, scipy CSR."""
+        # copies: sum_duplicates works in place and must not touch the row arrays
+        A = sp.csr_matrix((self.A.ravel().copy(), self._cols_flat.copy(), self.indptr.copy()),
+                          shape=(self.n, self.n))
+        A.sum_duplicates()
+        A.eliminate_zeros()
+        return A
+
+    def fixed_coupling(self, values):
+        """``A[:, fixed] @ values[fixed]`` (#E, k) in the mesh's edge order: the load
+        that the fixed DOFs put on the free rows."""
+        v = np.where(self.fixed[:, None], values[self.perm], 0.0)
+        out = np.empty_like(v)
+        out[self.perm] = np.einsum("es,esk->ek", self.A_full, v[self.cols])
+        return out
+
+    def _pcg(self, rhs, solver, rtol, S, prefer_lu, info):
+        n, k = rhs.shape
+        M = (self.indptr, self._cols_flat, self.M.ravel())
+        sub = {}
+        fn = self._two_level(S) if len(S) else None
+        if fn is not None:
+            sub = {"subdomain": S, "subdomain_solve": fn}
+        else:
+            info["sliver_dofs"] = 0
+        if solver == "cg":
+            X, it, status, relres = pcg(self.indptr, self._cols_flat, self.A.ravel(), rhs,
+                                        rtol=rtol, maxiter=CG_MAXITER, M=M,
+                                        overwrite_R=rhs.shape[1] <= 16, **sub)
+            info.update(iterations=it, solver="cg")
+            if status != 0:
+                raise SolverDidNotConverge(
+                    f"preconditioned CG did not converge in {it} iterations (relative residual "
+                    f"{max(relres):.2e} > {rtol:.1e}); the mesh may contain near-degenerate "
+                    f"triangles. Use solver='direct' or solver='auto'.")
+            return X, info
+        budget = np.inf
+        if n <= DIRECT_MAX:
+            per_iter = _pcg_iter_seconds(n, k) * (1.0 + 2.0 * len(S) / n)
+            budget = _direct_seconds(n) / per_iter
+        # rhs is this solve's private (permuted) copy: PCG uses it as its residual buffer
+        overwrite = rhs.shape[1] <= 16 and rhs.flags.c_contiguous and rhs.dtype == np.float64
+        X, it, status, relres = pcg(self.indptr, self._cols_flat, self.A.ravel(), rhs,
+                                    rtol=rtol, maxiter=CG_MAXITER, M=M, probe_iter=PROBE_ITER,
+                                    max_predicted=budget, overwrite_R=overwrite, **sub)
+        info.update(iterations=it, solver="cg")
+        if status != 0:
+            if n > DIRECT_MAX:
+                raise SolverDidNotConverge(
+                    f"preconditioned CG did not converge in {it} iterations (relative residual "
+                    f"{max(relres):.2e} > {rtol:.1e}) and the system ({n} unknowns) is too large "
+                    f"for the direct solver")
+            if overwrite:
+                # rhs now holds the final residual r = rhs - A X: rebuild rhs = r + A X
+                # (rounding ≤ eps ‖A X‖, and ‖A X‖ ≤ 1e4 ‖rhs‖ by the breakdown test)
+                rhs += np.einsum("es,esk->ek", self.A, X[self.cols])
+            X = cholesky_solve(self.csr(), rhs, prefer_lu=prefer_lu)
+            info.update(switched=True, solver="direct")
+        return X, info
+
+    def solve(self, rhs, solver="auto", rtol=DEFAULT_RTOL, overwrite_rhs=False):
+        """Solve ``A X = rhs`` (#E, k, the mesh's edge order) with the strategy in the module docstring.
+
+        Returns
+        -------
+        X : (#E, k) float64
+        info : SolveInfo
+
+        ``overwrite_rhs=True`` (a C-contiguous float64 ``rhs``) lets the solve use the
+        memory of ``rhs`` (its contents are destroyed): one #E × k array less.
+        """
+        if solver not in ("auto", "cg", "direct"):
+            raise ValueError(f"unknown solver {solver!r}; use 'auto', 'cg' or 'direct'")
+        if overwrite_rhs and isinstance(rhs, np.ndarray) and rhs.dtype == np.float64 \
+                and rhs.flags.c_contiguous and rhs.flags.writeable and rhs.ndim == 2:
+            rhs[:] = rhs[self.perm]          # permuted in place (one transient copy)
+        else:
+            rhs = np.ascontiguousarray(np.asarray(rhs, dtype=np.float64)[self.perm])
+        n, k = rhs.shape
+        t0 = time.perf_counter()
+        info = SolveInfo(solver=solver, iterations=0, switched=False)
+        if solver == "auto" and n <= AUTO_DIRECT_MAX:
+            solver = "direct"
+        # faces whose 3x3 block is numerically singular make A numerically semi-definite:
+        # LU with pivoting instead of Cholesky there
+        prefer_lu = self.n_jacobi_faces > 0
+        if solver == "direct":
+            X = cholesky_solve(self.csr(), rhs, prefer_lu=prefer_lu)
+            info["solver"] = "direct"
+        else:
+            S = self.sliver_dofs()
+            info["sliver_dofs"] = len(S)
+            if solver == "auto" and len(S) > SLIVER_MAX_FRACTION * n and n <= DIRECT_MAX:
+                X = cholesky_solve(self.csr(), rhs, prefer_lu=prefer_lu)
+                info["solver"] = "direct"
+            else:
+                X, info = self._pcg(rhs, solver, rtol, S, prefer_lu, info)
+        if not np.isfinite(X).all():
+            raise SolverError("the HHJ solve produced non-finite values")
+        out = np.empty_like(X)
+        out[self.perm] = X
+        del X
+        info["seconds"] = time.perf_counter() - t0
+        return out, info
