@@ -684,6 +684,17 @@ class BatchResult:
         return c
 
 
+def _quiet_loggers(names):
+    """Raise the named loggers above CRITICAL; returns {logger: previous level}."""
+    import logging
+    saved = {}
+    for name in names:
+        logger = logging.getLogger(name)
+        saved[logger] = logger.level
+        logger.setLevel(logging.CRITICAL + 1)
+    return saved
+
+
 def _in_process(groups, options, on_row):
     for group in groups:
         for job in group:                 # one by one: progress and Ctrl-C per mesh
@@ -886,12 +897,17 @@ def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per
         interrupted = True
     finally:
         bar.close()
+        # after Ctrl-C the comms die under Dask's background tasks, which log their
+        # tracebacks (CommClosedError) while the client closes: not the user's news
+        quiet = _quiet_loggers(("distributed", "tornado", "asyncio")) if interrupted else {}
         for obj in (own_client, cluster):
             if obj is not None:
                 try:
                     obj.close()
                 except Exception:         # already torn down by the interrupt
                     pass
+        for logger, level in quiet.items():
+            logger.setLevel(level)
         box = getattr(_local, "sandbox", None)
         if box is not None:
             box.close()

@@ -524,7 +524,7 @@ def build_parser():
     b.add_argument("inputs", nargs="+", metavar="INPUT")
     b.add_argument("-o", "--out", required=True, metavar="OUTDIR", help="output folder")
     b.add_argument("--scheduler", metavar="ADDRESS",
-                   help="Dask scheduler to use, e.g. tcp://10.0.0.1:8786 (default: embedded cluster)")
+                   help="Dask scheduler to use, e.g. tcp://<scheduler-host>:8786 (default: embedded cluster)")
     b.add_argument("--workers", type=int, metavar="N",
                    help="worker processes of the embedded cluster (default: number of cores; "
                         "0: in-process)")
