@@ -16,7 +16,7 @@ from . import kernels
 from . import recovery as _recovery
 from .boundary_estimation import BOUNDARY_TREATMENTS, estimate_boundary_normals
 from .hhj import HHJProjection, clamped_load
-from .mesh import TriangleMesh, as_mesh, mark_bad_vertices, per_vertex_array
+from .mesh import as_mesh, mark_bad_vertices, per_vertex_array
 from .solvers import DEFAULT_RTOL, HHJSystem
 
 __all__ = [
