@@ -46,6 +46,14 @@ def sequence(name, levels):
     raise KeyError(name)
 
 
+def write_off(path, V, F):
+    """Write (V, F) as an ascii OFF file with full float precision; returns ``path``."""
+    lines = ["OFF", f"{len(V)} {len(F)} 0"] + [" ".join(map(repr, map(float, v))) for v in V]
+    lines += ["3 " + " ".join(map(str, f)) for f in F]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
 def rng(seed=0):
     return np.random.default_rng(seed)
 

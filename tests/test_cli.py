@@ -8,7 +8,7 @@ import sys
 import igl
 import numpy as np
 import pytest
-from conftest import MESH_DIR
+from conftest import MESH_DIR, write_off
 
 from igl_hhj import baselines, cli
 from igl_hhj.mesh import TriangleMesh
@@ -39,13 +39,6 @@ def real_mesh(name):
     path = MESH_DIR / name
     if not path.is_file():
         pytest.skip(f"{path} absent")
-    return path
-
-
-def write_off(path, V, F):
-    lines = ["OFF", f"{len(V)} {len(F)} 0"] + [" ".join(map(repr, map(float, v))) for v in V]
-    lines += ["3 " + " ".join(map(str, f)) for f in F]
-    path.write_text("\n".join(lines) + "\n")
     return path
 
 

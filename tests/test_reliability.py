@@ -17,6 +17,7 @@ import igl
 import numpy as np
 import pytest
 from cli_driver import check_outcome, run_capped
+from conftest import write_off
 
 import igl_hhj
 from igl_hhj import baselines, cli, mesh
@@ -54,13 +55,6 @@ def thin_face(V, F, f, rel):
 def wavy_grid(n):
     P, F = square_grid(n)
     return np.column_stack([P, 0.3 * np.sin(3 * P[:, 0]) * np.cos(2 * P[:, 1])]), F
-
-
-def write_off(path, V, F):
-    lines = ["OFF", f"{len(V)} {len(F)} 0"] + [" ".join(map(repr, map(float, v))) for v in V]
-    lines += ["3 " + " ".join(map(str, f)) for f in F]
-    path.write_text("\n".join(lines) + "\n")
-    return path
 
 
 def one_error_line(err):
