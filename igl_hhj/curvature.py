@@ -551,9 +551,11 @@ def vertex_shape_operator(mesh, S, *, smoothing=0, recovery="patch"):
     N : (#V, 3) vertex normals used
     """
     _check_smoothing(smoothing, "smoothing")
-    Sv, N = _recovery.recover_vertex_tensors(mesh, S, method=recovery)
+    w = _recovery.recovery_weights(mesh)          # one computation for recovery and smoothing
+    Sv, N = _recovery.recover_vertex_tensors(mesh, S, method=recovery, weights=w)
     if smoothing > 0:
-        Sv = _recovery.smooth_vertex_tensors(mesh, Sv, N, _recovery.smoothing_length(mesh, smoothing))
+        Sv = _recovery.smooth_vertex_tensors(mesh, Sv, N, _recovery.smoothing_length(mesh, smoothing),
+                                             weights=w)
     return Sv, N
 
 

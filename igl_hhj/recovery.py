@@ -334,7 +334,7 @@ def _diffuse(A, L, X0, ref, t, rtol):
 
 
 def smooth_vertex_tensors(mesh: TriangleMesh, Sv, N, length, *, steps=SMOOTHING_STEPS,
-                          order=SMOOTHING_ORDER, keep_trace=True, rtol=3e-3):
+                          order=SMOOTHING_ORDER, keep_trace=True, rtol=3e-3, weights=None):
     """Implicit diffusion of a per-vertex tensor field at length ℓ, then tangent projection.
 
     ``G`` is ``steps`` implicit steps ``(M_w + (ℓ²/steps) L_w) X = M_w X_prev`` on the six
@@ -359,6 +359,8 @@ def smooth_vertex_tensors(mesh: TriangleMesh, Sv, N, length, *, steps=SMOOTHING_
     rtol : relative residual of each CG solve for the correction ``X - X_prev``
         (default 3e-3: the correction is itself O(ℓ²ΔS), so its 0.3 % error is far
         below the smoothing's bias; 5–7 CG iterations per solve).
+    weights : (#F,) optional face weights, default :func:`recovery_weights` (pass the
+        ones the recovery used to compute them once).
 
     Returns
     -------
@@ -367,7 +369,7 @@ def smooth_vertex_tensors(mesh: TriangleMesh, Sv, N, length, *, steps=SMOOTHING_
     if not length > 0:
         return Sv
     ref = mesh.referenced_vertices
-    M, L = smoothing_matrices(mesh)
+    M, L = smoothing_matrices(mesh, weights)
     t = length ** 2 / steps
     A = (M + t * L).tocsr()
     X0 = np.where(ref[:, None], _to6(Sv), 0.0)
