@@ -28,6 +28,28 @@ __all__ = [
 
 
 # --------------------------------------------------------------------------- helpers
+def _simply_supported_mask(edges, n_points, boundary_normals, boundary_shape_operator,
+                           simply_supported, points="#V"):
+    """(len(edges),) bool: which boundary ``edges`` (pairs of point indices) are simply
+    supported, from the boundary arguments of :func:`shape_operator` (also used by
+    :func:`igl_hhj.curved.shape_operator`, whose points are the ``#N`` nodes)."""
+    if simply_supported is not None:
+        if boundary_shape_operator is None:
+            raise ValueError("simply_supported needs boundary_shape_operator (the data on those edges)")
+        flag = np.asarray(simply_supported)
+        if flag.shape != (n_points,):
+            raise ValueError(f"simply_supported must have shape ({n_points},), got {flag.shape}")
+        if flag.dtype != bool:
+            raise TypeError(f"simply_supported must be a boolean array, got dtype {flag.dtype}")
+        return flag[edges[:, 0]] & flag[edges[:, 1]]
+    if boundary_shape_operator is not None:
+        if boundary_normals is not None:
+            raise ValueError("both boundary_normals and boundary_shape_operator given: pass "
+                             f"simply_supported ({points} bool) to say which boundary edges are simply supported")
+        return np.ones(len(edges), dtype=bool)
+    return np.zeros(len(edges), dtype=bool)
+
+
 def _boundary_partition(mesh, boundary_normals, boundary_shape_operator, simply_supported,
                         estimated=False):
     """Return (clamped_with_data (#E,) bool, simply_supported_edges (#E,) bool).
@@ -35,21 +57,8 @@ def _boundary_partition(mesh, boundary_normals, boundary_shape_operator, simply_
     ``estimated``: the normals come from :func:`estimate_boundary_normals`, whose NaN
     rows mark vertices without a usable normal; their edges keep the plain assembly."""
     bnd = mesh.boundary_edges
-    ss_edges = np.zeros(mesh.n_edges, dtype=bool)
-    if simply_supported is not None:
-        if boundary_shape_operator is None:
-            raise ValueError("simply_supported needs boundary_shape_operator (the data on those edges)")
-        flag = np.asarray(simply_supported)
-        if flag.shape != (mesh.n_vertices,):
-            raise ValueError(f"simply_supported must have shape ({mesh.n_vertices},), got {flag.shape}")
-        if flag.dtype != bool:
-            raise TypeError(f"simply_supported must be a boolean array, got dtype {flag.dtype}")
-        ss_edges = bnd & flag[mesh.edges[:, 0]] & flag[mesh.edges[:, 1]]
-    elif boundary_shape_operator is not None:
-        if boundary_normals is not None:
-            raise ValueError("both boundary_normals and boundary_shape_operator given: pass "
-                             "simply_supported (#V bool) to say which boundary edges are simply supported")
-        ss_edges = bnd.copy()
+    ss_edges = bnd & _simply_supported_mask(mesh.edges, mesh.n_vertices, boundary_normals,
+                                            boundary_shape_operator, simply_supported)
     clamped = bnd & ~ss_edges if boundary_normals is not None else np.zeros_like(bnd)
     if estimated:
         usable = np.isfinite(boundary_normals).all(axis=1)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..curvature import _simply_supported_mask
 from .field import CurvedField
 from .hhj import CurvedHHJ
 from .surface import LagrangeSurface
@@ -75,21 +76,8 @@ def shape_operator(surface, *, boundary_normals=None, boundary_shape_operator=No
     A, B = space.matrices
     mesh = surface.mesh
     bnd = np.flatnonzero(mesh.boundary_edges)
-    ss = np.zeros(len(bnd), dtype=bool)
-    if simply_supported is not None:
-        if boundary_shape_operator is None:
-            raise ValueError("simply_supported needs boundary_shape_operator (the data on those edges)")
-        flag = np.asarray(simply_supported)
-        if flag.shape != (surface.n_nodes,):
-            raise ValueError(f"simply_supported must have shape ({surface.n_nodes},), got {flag.shape}")
-        if flag.dtype != bool:
-            raise TypeError(f"simply_supported must be a boolean array, got dtype {flag.dtype}")
-        ss = flag[mesh.edges[bnd, 0]] & flag[mesh.edges[bnd, 1]]
-    elif boundary_shape_operator is not None:
-        if boundary_normals is not None:
-            raise ValueError("both boundary_normals and boundary_shape_operator given: pass "
-                             "simply_supported (#N bool) to say which boundary edges are simply supported")
-        ss[:] = True
+    ss = _simply_supported_mask(mesh.edges[bnd], surface.n_nodes, boundary_normals,
+                                boundary_shape_operator, simply_supported, points="#N")
     clamped_e, ss_e = bnd[~ss], bnd[ss]
     X = surface.nodes
     rhs = -(B @ X)
