@@ -369,6 +369,31 @@ def refine_planar(P, F, boundary_projection=None, levels=1):
     return P, np.asarray(F, dtype=np.int64)
 
 
+def coarse_barycentrics(P0, F0, Q, coarse_face):
+    """Where points of a straight coarse mesh lie, for the blended boundary maps.
+
+    Parameters
+    ----------
+    P0 : (#V0, 2), F0 : (#F0, 3) straight coarse mesh.
+    Q : (n, 2) points, coarse_face : (n,) int, a coarse face containing each point.
+
+    Returns
+    -------
+    is_bnd : (#F0, 3) bool, local edge j (opposite corner j) of the face is a boundary edge
+    T : (n, 3, 2) corners of each point's coarse face
+    lam : (n, 3) barycentric coordinates of each point in it
+    """
+    import igl
+    F0 = np.asarray(F0, dtype=np.int64)
+    _, J, K = igl.boundary_facets(F0)
+    is_bnd = np.zeros(F0.shape, dtype=bool)
+    is_bnd[np.asarray(J), np.asarray(K)] = True
+    T = P0[F0[coarse_face]]
+    M = np.stack([T[:, 1] - T[:, 0], T[:, 2] - T[:, 0]], axis=-1)
+    l12 = np.linalg.solve(M, (Q - T[:, 0])[..., None])[..., 0]
+    return is_bnd, T, np.column_stack([1.0 - l12.sum(axis=1), l12])
+
+
 def blended_map(P0, F0, Q, coarse_face, edge_curve):
     """Curved-element (Zlámal / Gordon–Hall blending, "Lenoir type") map of the coarse mesh.
 
@@ -405,15 +430,7 @@ def blended_map(P0, F0, Q, coarse_face, edge_curve):
     -------
     X : (n, 2) float64
     """
-    import igl
-    F0 = np.asarray(F0, dtype=np.int64)
-    _, J, K = igl.boundary_facets(F0)
-    is_bnd = np.zeros(F0.shape, dtype=bool)        # (#F0, 3): local edge opposite corner j
-    is_bnd[np.asarray(J), np.asarray(K)] = True
-    T = P0[F0[coarse_face]]                        # (n, 3, 2)
-    M = np.stack([T[:, 1] - T[:, 0], T[:, 2] - T[:, 0]], axis=-1)
-    l12 = np.linalg.solve(M, (Q - T[:, 0])[..., None])[..., 0]
-    lam = np.column_stack([1.0 - l12.sum(axis=1), l12])
+    is_bnd, T, lam = coarse_barycentrics(P0, F0, Q, coarse_face)
     X = np.array(Q, dtype=np.float64, copy=True)
     for j in range(3):                              # the 3 local edges, vectorised over points
         a, b = (j + 1) % 3, (j + 2) % 3
