@@ -560,6 +560,14 @@ def vertex_shape_operator(mesh, S, *, smoothing=0, recovery="patch"):
     N : (#V, 3) vertex normals used
     """
     _check_smoothing(smoothing, "smoothing")
+    length = _recovery.smoothing_length(mesh, smoothing) if smoothing > 0 else 0.0
+    if recovery == "patch":       # compiled (reference: _vertex_shape_operator_numpy)
+        return _recovery.recover_and_smooth(mesh, S, length)
+    return _vertex_shape_operator_numpy(mesh, S, smoothing=smoothing, recovery=recovery)
+
+
+def _vertex_shape_operator_numpy(mesh, S, *, smoothing=0, recovery="patch"):
+    """The readable numpy reference of :func:`vertex_shape_operator` (any ``recovery``)."""
     w = _recovery.recovery_weights(mesh)          # one computation for recovery and smoothing
     Sv, N = _recovery.recover_vertex_tensors(mesh, S, method=recovery, weights=w)
     if smoothing > 0:

@@ -35,7 +35,7 @@ from .mesh import TriangleMesh
 
 __all__ = [
     "face_quality", "recovery_weights", "recovery_operator", "vertex_confidence", "QUALITY_FLOOR", "recover_vertex_tensors", "smooth_vertex_tensors",
-    "smoothing_length", "smoothing_matrices", "boundary_band", "BOUNDARY_LENGTH_FACTOR", "SMOOTHING_PER_RADIUS", "SMOOTHING_STEPS", "SMOOTHING_ORDER", "tangent_projection",
+    "smoothing_length", "smoothing_matrices", "smoothing_coefficients", "recover_and_smooth", "boundary_band", "BOUNDARY_LENGTH_FACTOR", "SMOOTHING_PER_RADIUS", "SMOOTHING_STEPS", "SMOOTHING_ORDER", "tangent_projection",
 ]
 
 # Smoothing length ℓ = SMOOTHING_PER_RADIUS · radius · h̄ (h̄ = mean edge length).
@@ -276,15 +276,39 @@ def boundary_band(mesh: TriangleMesh, rings=BOUNDARY_BAND_RINGS):
     b = mesh.boundary_vertices.copy()
     if not b.any():
         return b
-    F = mesh.F
-    nV = mesh.n_vertices
-    i = np.concatenate([F[:, 0], F[:, 1], F[:, 2]])
-    j = np.concatenate([F[:, 1], F[:, 2], F[:, 0]])
-    A = sp.coo_matrix((np.ones(len(i)), (i, j)), shape=(nV, nV)).tocsr()
-    A = A + A.T
+    E = mesh.edges
     for _ in range(rings):
-        b = b | (A @ b.astype(np.float64) > 0)
+        grow = b[E]                       # (#E, 2): which endpoints are in the band
+        b[E[grow[:, 1], 0]] = True
+        b[E[grow[:, 0], 1]] = True
     return b
+
+
+def smoothing_coefficients(mesh: TriangleMesh, weights=None):
+    """Per-face stiffness entries and lumped mass of the smoothing (see :func:`smoothing_matrices`).
+
+    Returns
+    -------
+    C : (#F, 3) float64, ``b_T² r_T`` times libigl's cotangent entry of the edge
+        opposite corner i (``igl.cotmatrix_entries``), non-finite entries 0.
+    m : (#V,) float64, ``Σ_{T∋v} r_T w_T / 3``, floored at 1e-12 of its maximum.
+    """
+    import igl
+    w = recovery_weights(mesh) if weights is None else weights
+    F = mesh.F
+    with np.errstate(invalid="ignore", divide="ignore"):
+        fac = np.where(mesh.face_areas > 0, w / mesh.face_areas, 0.0)
+    stiff = fac
+    if mesh.has_boundary:       # longer smoothing length ℓ near the boundary: t ∝ ℓ²
+        near = boundary_band(mesh)[F].any(axis=1)
+        stiff = fac * np.where(near, BOUNDARY_LENGTH_FACTOR ** 2, 1.0)
+    C = np.asarray(igl.cotmatrix_entries(mesh.V, F), dtype=np.float64) * stiff[:, None]
+    C = np.where(np.isfinite(C), C, 0.0)
+    # mass ~ w·(w/|T|): an unreliable face loses its data faster than its coupling,
+    # so vertices surrounded by unreliable faces are interpolated from their neighbours
+    m = np.bincount(F.ravel(), weights=np.repeat(w * fac / 3.0, 3), minlength=mesh.n_vertices)
+    floor = 1e-12 * max(float(m.max()), 1e-300)
+    return C, np.maximum(m, floor)
 
 
 def smoothing_matrices(mesh: TriangleMesh, weights=None):
@@ -298,34 +322,22 @@ def smoothing_matrices(mesh: TriangleMesh, weights=None):
     each face's stiffness by its reliability keeps it positive semidefinite and
     bounds the cotangent weights of slivers (which grow like 1/q): without it a
     sliver couples its vertices with weights ~1/q and spreads its error.
+    (Entries: :func:`smoothing_coefficients`.)
 
     Returns
     -------
     M : (#V, #V) sparse diagonal, L : (#V, #V) sparse symmetric PSD.
     """
-    import igl
-    w = recovery_weights(mesh) if weights is None else weights
+    C, m = smoothing_coefficients(mesh, weights)
     nV = mesh.n_vertices
     F = mesh.F
-    with np.errstate(invalid="ignore", divide="ignore"):
-        fac = np.where(mesh.face_areas > 0, w / mesh.face_areas, 0.0)
-    stiff = fac
-    if mesh.has_boundary:       # longer smoothing length ℓ near the boundary: t ∝ ℓ²
-        near = boundary_band(mesh)[F].any(axis=1)
-        stiff = fac * np.where(near, BOUNDARY_LENGTH_FACTOR ** 2, 1.0)
-    C = np.asarray(igl.cotmatrix_entries(mesh.V, F), dtype=np.float64) * stiff[:, None]
-    C = np.where(np.isfinite(C), C, 0.0)
     j = F[:, [1, 2, 0]]
     k = F[:, [2, 0, 1]]
     rows = np.concatenate([j.ravel(), k.ravel(), j.ravel(), k.ravel()])
     cols = np.concatenate([k.ravel(), j.ravel(), j.ravel(), k.ravel()])
     vals = np.concatenate([-C.ravel(), -C.ravel(), C.ravel(), C.ravel()])
     L = sp.coo_matrix((vals, (rows, cols)), shape=(nV, nV)).tocsr()
-    # mass ~ w·(w/|T|): an unreliable face loses its data faster than its coupling,
-    # so vertices surrounded by unreliable faces are interpolated from their neighbours
-    m = mesh.sum_corners_to_vertices(np.broadcast_to((w * fac / 3.0)[:, None], (mesh.n_faces, 3)))
-    floor = 1e-12 * max(float(m.max()), 1e-300)
-    return sp.diags(np.maximum(m, floor)).tocsr(), L
+    return sp.diags(m).tocsr(), L
 
 
 def _diffuse(A, L, X0, ref, t, rtol):
@@ -374,13 +386,63 @@ def smooth_vertex_tensors(mesh: TriangleMesh, Sv, N, length, *, steps=SMOOTHING_
     A = (M + t * L).tocsr()
     X0 = np.where(ref[:, None], _to6(Sv), 0.0)
     # (I - (I - G)^order) X0 = Σ_j binom(order, j) (-1)^(j+1) G^j X0
-    from math import comb
     X = np.zeros_like(X0)
     Y = X0
-    for j in range(1, order + 1):
+    for c in _kernel_coefficients(order):
         for _ in range(steps):
             Y = _diffuse(A, L, Y, ref, t, rtol)
-        X += comb(order, j) * (-1) ** (j + 1) * Y
+        X += c * Y
     out = np.full_like(Sv, np.nan)
     out[ref] = tangent_projection(_from6(X[ref]), N[ref], keep_trace=keep_trace)
     return out
+
+
+def _kernel_coefficients(order):
+    """binom(order, j) (-1)^(j+1), j = 1..order: ``I - (I - G)^order = Σ_j c_j G^j``."""
+    from math import comb
+    return [comb(order, j) * (-1) ** (j + 1) for j in range(1, order + 1)]
+
+
+def recover_and_smooth(mesh: TriangleMesh, S, length, *, weights=None, normals=None,
+                       steps=SMOOTHING_STEPS, order=SMOOTHING_ORDER, rtol=3e-3):
+    """Compiled patch recovery + smoothing of the drop-in (one pass each, no sparse matrices).
+
+    Equals ``smooth_vertex_tensors(mesh, *recover_vertex_tensors(mesh, S, weights=w), length,
+    weights=w)`` (the numpy reference, compared in ``tests/test_core.py``): the
+    patch recovery (:func:`igl_hhj.kernels.patch_recovery`), then ``steps × order``
+    Jacobi-PCG diffusion solves on the vertex graph
+    (:func:`igl_hhj.kernels.smooth_vertex_tensors`, entries from
+    :func:`smoothing_coefficients`), then the trace-keeping tangent projection.  Should a
+    diffusion solve not converge in 500 iterations, the numpy reference (which
+    falls back to a sparse factorisation) takes over.
+
+    Parameters
+    ----------
+    S : (#F, 3, 3) face tensors.
+    length : float, smoothing length ℓ ≥ 0 (0: recovery only).
+    weights : (#F,) optional, default the compiled :func:`recovery_weights`.
+    normals : (#V, 3) optional unit vertex normals (default ``mesh.vertex_normals``).
+
+    Returns
+    -------
+    Sv : (#V, 3, 3) symmetric tangential tensors (NaN rows for unreferenced vertices)
+    N : (#V, 3) the normals used
+    """
+    from . import kernels
+    N = mesh.vertex_normals if normals is None else normals
+    w = kernels.recovery_weights(mesh, QUALITY_FLOOR) if weights is None else weights
+    X = kernels.patch_recovery(mesh, S, N, w)            # (#V, 6), tangent-projected
+    if length > 0:
+        C, m = smoothing_coefficients(mesh, w)
+        status, _ = kernels.smooth_vertex_tensors(mesh, X, C, m, length ** 2 / steps, steps,
+                                                  _kernel_coefficients(order), rtol, 500)
+        if status != 0:      # a diffusion solve stalled: the reference's direct fallback
+            Sv = np.full((mesh.n_vertices, 3, 3), np.nan)
+            ref = mesh.referenced_vertices
+            Sv[ref] = _from6(kernels.patch_recovery(mesh, S, N, w)[ref])
+            return smooth_vertex_tensors(mesh, Sv, N, length, steps=steps, order=order, rtol=rtol,
+                                         weights=w), N
+        kernels.tangent_projection6(mesh, X, N)
+    Sv = _from6(X)
+    Sv[~mesh.referenced_vertices] = np.nan
+    return Sv, N

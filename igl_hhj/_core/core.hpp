@@ -111,6 +111,17 @@ void lumped_vertex_recovery(const double* V, const i64* F, i64 nF, i64 nV, const
 void principal_2x2(const double* S, const double* N, i64 n, double* PD1, double* PD2,
                    double* PV1, double* PV2, int nt);
 
+// recovery_kernels.cpp
+void recovery_weights(const double* V, const i64* F, i64 nF, const i64* FE, const i64* EF, i64 nE,
+                      double floor, double* w, int nt);
+void patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S, const double* N,
+                    const double* w, const unsigned char* ref, double h, double* X);
+void tangent_projection6(double* X, const double* N, const unsigned char* ref, i64 n, bool keep_trace,
+                         int nt);
+int smooth_vertex_tensors(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* ELI, const double* C,
+                          const double* m, double t, int steps, const std::vector<double>& binom,
+                          double rtol, i64 maxiter, double* X, int nt, i64* iterations);
+
 // pcg.cpp
 struct PCGResult {
     i64 iterations = 0;

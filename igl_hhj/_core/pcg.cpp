@@ -62,6 +62,7 @@ void apply_and_dot(i64 n, int k, const i64* p, const std::int32_t* idx, const do
     switch (k) {
         case 1: apply_and_dot_k<1>(n, k, p, idx, v, dinv, x, y, d, P, nt); break;
         case 3: apply_and_dot_k<3>(n, k, p, idx, v, dinv, x, y, d, P, nt); break;
+        case 6: apply_and_dot_k<6>(n, k, p, idx, v, dinv, x, y, d, P, nt); break;
         default: apply_and_dot_k<0>(n, k, p, idx, v, dinv, x, y, d, P, nt);
     }
 }
@@ -96,6 +97,7 @@ void update(i64 n, int k, const double* alpha, double* X, double* r, const doubl
     switch (k) {
         case 1: update_k<1>(n, k, alpha, X, r, p, q, P, nt); break;
         case 3: update_k<3>(n, k, alpha, X, r, p, q, P, nt); break;
+        case 6: update_k<6>(n, k, alpha, X, r, p, q, P, nt); break;
         default: update_k<0>(n, k, alpha, X, r, p, q, P, nt);
     }
 }

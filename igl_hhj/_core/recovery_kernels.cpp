@@ -1,0 +1,295 @@
+// Vertex recovery and smoothing of the drop-in (igl_hhj/recovery.py is the readable
+// numpy reference of every kernel here; tests/test_core.py compares them):
+// face reliability weights, the patch recovery (weighted linear least-squares fit
+// in each vertex's tangent frame), the trace-keeping tangent projection and the
+// twiced implicit diffusion of the six tensor components (CSR assembled from the
+// unique edges, Jacobi block PCG from pcg.cpp).  Scatters over corners run
+// serially in face order and reductions use pcg.cpp's fixed chunking, so results
+// do not depend on the thread count.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core.hpp"
+
+namespace hhj {
+
+namespace {
+// Symmetric tensor components in the order of recovery._SYM.
+constexpr int SYM[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
+
+inline void face_cross(const double* V, const i64* F, i64 f, double c[3]) {
+    const double* x0 = V + 3 * F[3 * f];
+    const double* x1 = V + 3 * F[3 * f + 1];
+    const double* x2 = V + 3 * F[3 * f + 2];
+    const double e1[3] = {x1[0] - x0[0], x1[1] - x0[1], x1[2] - x0[2]};
+    const double e2[3] = {x2[0] - x0[0], x2[1] - x0[1], x2[2] - x0[2]};
+    cross3(e1, e2, c);
+}
+
+// Tangent frame of recovery.recovery_operator: e1 = N x a / |N x a| (a = the first
+// coordinate axis least aligned with N), e2 = N x e1.
+inline void tangent_frame(const double* n, double e1[3], double e2[3]) {
+    int ax = 0;
+    double best = std::fabs(n[0]);
+    for (int a = 1; a < 3; ++a)
+        if (std::fabs(n[a]) < best) { best = std::fabs(n[a]); ax = a; }
+    double axis[3] = {0, 0, 0};
+    axis[ax] = 1.0;
+    cross3(n, axis, e1);
+    const double ne = std::sqrt(dot3(e1, e1));
+    for (int a = 0; a < 3; ++a) e1[a] /= ne;
+    cross3(n, e1, e2);
+}
+}  // namespace
+
+// recovery_weights: w[f] = |T| min(1, q~_T / floor), q_T = 4 sqrt(3) |T| / (l0^2 + l1^2 + l2^2)
+// (recovery.face_quality, non-finite -> 0), q~_T = min of q over T and its edge
+// neighbours (recovery.recovery_weights).  FE (#F,3), EF (#E,2); w (#F,).
+void recovery_weights(const double* V, const i64* F, i64 nF, const i64* FE, const i64* EF, i64 nE,
+                      double floor, double* w, int nt) {
+    std::vector<double> q(nF), qe(nE);
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+    for (i64 f = 0; f < nF; ++f) {
+        double c[3];
+        face_cross(V, F, f, c);
+        const double area = 0.5 * std::sqrt(dot3(c, c));
+        double l2 = 0.0;
+        for (int i = 0; i < 3; ++i) {
+            const double* a = V + 3 * F[3 * f + (i + 1) % 3];
+            const double* b = V + 3 * F[3 * f + (i + 2) % 3];
+            const double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+            const double l = std::sqrt(dot3(d, d));
+            l2 += l * l;
+        }
+        const double qf = 4.0 * std::sqrt(3.0) * area / l2;
+        q[f] = std::isfinite(qf) ? qf : 0.0;
+        w[f] = area;
+    }
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+    for (i64 e = 0; e < nE; ++e) {
+        const i64 f0 = EF[2 * e], f1 = EF[2 * e + 1];
+        const double inf = std::numeric_limits<double>::infinity();
+        qe[e] = std::min(f0 >= 0 ? q[f0] : inf, f1 >= 0 ? q[f1] : inf);
+    }
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+    for (i64 f = 0; f < nF; ++f) {
+        const double qt = std::min(qe[FE[3 * f]], std::min(qe[FE[3 * f + 1]], qe[FE[3 * f + 2]]));
+        w[f] *= std::min(1.0, qt / floor);
+    }
+}
+
+// patch_recovery: X[v] (6 components) = sum_{T ∋ v} k_{v,T} S_T, the rows of
+// recovery.recovery_operator("patch"): k = w_T (g0 + g1 u_T + g2 v_T) / det, the
+// weighted least-squares fit of a + b u + c v to the face values at the centroid
+// offsets (u_T, v_T) / h in v's tangent frame, evaluated at the vertex; the lumped
+// weight w_T / sum w where the linear part is ill-conditioned.  S (#F,9), N (#V,3)
+// (non-finite entries count as 0), w (#F,), ref (#V,) referenced flags, h the mean
+// edge length; X (#V,6), rows of unreferenced vertices 0.
+void patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S, const double* N,
+                    const double* w, const unsigned char* ref, double h, double* X) {
+    std::vector<double> s0(nV, 0.0);
+    for (i64 f = 0; f < nF; ++f)
+        for (int c = 0; c < 3; ++c) s0[F[3 * f + c]] += w[f];
+    // vertices whose faces all have weight 0: plain average (weight 1 per face)
+    std::vector<unsigned char> lost(nV, 0);
+    bool any_lost = false;
+    for (i64 v = 0; v < nV; ++v) {
+        lost[v] = ref[v] && !(s0[v] > 0);
+        any_lost = any_lost || lost[v];
+    }
+    auto corner_weight = [&](i64 f, i64 v) { return lost[v] ? 1.0 : w[f]; };
+    double wmax = 0.0;
+    if (any_lost) std::fill(s0.begin(), s0.end(), 0.0);
+    for (i64 f = 0; f < nF; ++f)
+        for (int c = 0; c < 3; ++c) {
+            const i64 v = F[3 * f + c];
+            const double W = corner_weight(f, v);
+            if (any_lost) s0[v] += W;
+            wmax = std::max(wmax, W);
+        }
+    wmax = std::max(wmax, std::numeric_limits<double>::min());
+    // frames
+    std::vector<double> E((size_t)nV * 6);
+    for (i64 v = 0; v < nV; ++v) {
+        double n[3];
+        for (int a = 0; a < 3; ++a) n[a] = std::isfinite(N[3 * v + a]) ? N[3 * v + a] : 0.0;
+        if (!ref[v]) { n[0] = 0.0; n[1] = 0.0; n[2] = 1.0; }
+        tangent_frame(n, &E[6 * v], &E[6 * v + 3]);
+    }
+    auto offsets = [&](i64 f, i64 v, double& u, double& t) {
+        const double* x0 = V + 3 * F[3 * f];
+        const double* x1 = V + 3 * F[3 * f + 1];
+        const double* x2 = V + 3 * F[3 * f + 2];
+        double d[3];
+        for (int a = 0; a < 3; ++a) d[a] = ((x0[a] + x1[a] + x2[a]) / 3.0 - V[3 * v + a]) / h;
+        u = dot3(d, &E[6 * v]);
+        t = dot3(d, &E[6 * v + 3]);
+    };
+    // moments of the weighted fit: a, b, c, d, e, f = sum W (1, u, v, uu, uv, vv)
+    std::vector<double> mom((size_t)nV * 6, 0.0);
+    for (i64 f = 0; f < nF; ++f)
+        for (int c = 0; c < 3; ++c) {
+            const i64 v = F[3 * f + c];
+            double u, t;
+            offsets(f, v, u, t);
+            const double W = corner_weight(f, v) / wmax;
+            double* m = &mom[6 * v];
+            m[0] += W; m[1] += W * u; m[2] += W * t;
+            m[3] += W * u * u; m[4] += W * u * t; m[5] += W * t * t;
+        }
+    // per vertex: g / det of the fit (3 values) and whether it is well posed
+    std::vector<double> g((size_t)nV * 3, 0.0);
+    std::vector<unsigned char> good(nV, 0);
+    for (i64 v = 0; v < nV; ++v) {
+        const double* m = &mom[6 * v];
+        const double a = m[0], b = m[1], c = m[2], d = m[3], e = m[4], ff = m[5];
+        const double g0 = d * ff - e * e, g1 = c * e - b * ff, g2 = b * e - c * d;
+        const double det = a * g0 + b * g1 + c * g2;
+        const double mu = b / a, mv = c / a;
+        const double cuu = d / a - mu * mu, cuv = e / a - mu * mv, cvv = ff / a - mv * mv;
+        const double tr = cuu + cvv;
+        good[v] = ref[v] && !lost[v] && a > 0 && (cuu * cvv - cuv * cuv > 0.05 * tr * tr) &&
+                  (tr > 0.05 * (d + ff) / a) && std::isfinite(det) && det != 0.0;
+        g[3 * v] = g0 / det; g[3 * v + 1] = g1 / det; g[3 * v + 2] = g2 / det;
+    }
+    std::fill(X, X + (size_t)nV * 6, 0.0);
+    for (i64 f = 0; f < nF; ++f)
+        for (int c = 0; c < 3; ++c) {
+            const i64 v = F[3 * f + c];
+            double k;
+            if (good[v]) {
+                double u, t;
+                offsets(f, v, u, t);
+                const double W = corner_weight(f, v) / wmax;
+                k = W * (g[3 * v] + g[3 * v + 1] * u + g[3 * v + 2] * t);
+            } else {
+                k = corner_weight(f, v) / s0[v];
+            }
+            if (!std::isfinite(k)) k = 0.0;
+            const double* Sf = S + 9 * f;
+            for (int s = 0; s < 6; ++s) X[6 * v + s] += k * Sf[3 * SYM[s][0] + SYM[s][1]];
+        }
+}
+
+// tangent_projection6: X[r] <- P S P (symmetrised) + keep_trace * (N^T S N) P / 2,
+// P = I - N N^T, on the 6-component rows with ref[r] set (recovery.tangent_projection);
+// other rows are left alone.
+void tangent_projection6(double* X, const double* N, const unsigned char* ref, i64 n, bool keep_trace,
+                         int nt) {
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+    for (i64 r = 0; r < n; ++r) {
+        if (ref && !ref[r]) continue;
+        double S[3][3], P[3][3], T[3][3], U[3][3];
+        for (int s = 0; s < 6; ++s) S[SYM[s][0]][SYM[s][1]] = S[SYM[s][1]][SYM[s][0]] = X[6 * r + s];
+        const double* nv = N + 3 * r;
+        for (int p = 0; p < 3; ++p)
+            for (int q = 0; q < 3; ++q) P[p][q] = (p == q ? 1.0 : 0.0) - nv[p] * nv[q];
+        for (int p = 0; p < 3; ++p)
+            for (int q = 0; q < 3; ++q) T[p][q] = P[p][0] * S[0][q] + P[p][1] * S[1][q] + P[p][2] * S[2][q];
+        for (int p = 0; p < 3; ++p)
+            for (int q = 0; q < 3; ++q) U[p][q] = T[p][0] * P[0][q] + T[p][1] * P[1][q] + T[p][2] * P[2][q];
+        double nsn = 0.0;
+        if (keep_trace)
+            for (int p = 0; p < 3; ++p)
+                for (int q = 0; q < 3; ++q) nsn += nv[p] * S[p][q] * nv[q];
+        for (int s = 0; s < 6; ++s) {
+            const int p = SYM[s][0], q = SYM[s][1];
+            X[6 * r + s] = 0.5 * (U[p][q] + U[q][p]) + 0.5 * nsn * P[p][q];
+        }
+    }
+}
+
+// vertex_laplacian: CSR structure of the vertex graph from the unique edges E (#E,2,
+// lexicographic (min, max) pairs) plus the diagonal: row v = [lower neighbours,
+// v, upper neighbours], ascending.  L values: -w_e off the diagonal, sum of the w_e
+// on it, w_e = sum over the edge's faces of C[f, i] (C (#F,3): the face's cotangent
+// stiffness entry of the edge opposite corner i, recovery.smoothing_matrices).
+void vertex_laplacian(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* ELI, const double* C,
+                      std::vector<i64>& indptr, std::vector<std::int32_t>& indices,
+                      std::vector<double>& L, std::vector<i64>& diag_pos) {
+    indptr.assign(nV + 1, 0);
+    for (i64 e = 0; e < nE; ++e) { ++indptr[E[2 * e] + 1]; ++indptr[E[2 * e + 1] + 1]; }
+    for (i64 v = 0; v < nV; ++v) indptr[v + 1] += indptr[v] + 1;   // + 1: the diagonal
+    const i64 nnz = indptr[nV];
+    indices.assign(nnz, 0);
+    L.assign(nnz, 0.0);
+    diag_pos.assign(nV, 0);
+    std::vector<i64> fill(indptr.begin(), indptr.end() - 1), pos_hi(nE), pos_lo(nE);
+    // row max(e): the lower neighbour min(e); edges are sorted by min, so ascending
+    for (i64 e = 0; e < nE; ++e) { pos_hi[e] = fill[E[2 * e + 1]]; indices[fill[E[2 * e + 1]]++] = (std::int32_t)E[2 * e]; }
+    for (i64 v = 0; v < nV; ++v) { diag_pos[v] = fill[v]; indices[fill[v]++] = (std::int32_t)v; }
+    // row min(e): the upper neighbour max(e); contiguous and ascending in the edge order
+    for (i64 e = 0; e < nE; ++e) { pos_lo[e] = fill[E[2 * e]]; indices[fill[E[2 * e]]++] = (std::int32_t)E[2 * e + 1]; }
+    for (i64 e = 0; e < nE; ++e) {
+        double we = 0.0;
+        for (int s = 0; s < 2; ++s) {
+            const i64 f = EF[2 * e + s];
+            if (f >= 0) we += C[3 * f + ELI[2 * e + s]];
+        }
+        L[pos_lo[e]] = -we;
+        L[pos_hi[e]] = -we;
+        L[diag_pos[E[2 * e]]] += we;
+        L[diag_pos[E[2 * e + 1]]] += we;
+    }
+}
+
+// smooth_vertex_tensors: (I - (I - G)^order) X on the 6 columns of X (#V,6), in place,
+// G = `steps` implicit steps (M + t L) Y = M Y_prev solved for the correction:
+// (M + t L) dY = -t L Y_prev, Jacobi block PCG to rtol (maxiter iterations), as
+// recovery.smooth_vertex_tensors.  m (#V,) the lumped mass (floored), binom the
+// coefficients binom(order, j) (-1)^(j+1), j = 1..order.  Returns 0, or the PCG
+// status of the first solve that did not converge (X is then unspecified).
+int smooth_vertex_tensors(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* ELI, const double* C,
+                          const double* m, double t, int steps, const std::vector<double>& binom,
+                          double rtol, i64 maxiter, double* X, int nt, i64* iterations) {
+    std::vector<i64> indptr, diag_pos;
+    std::vector<std::int32_t> indices;
+    std::vector<double> L;
+    vertex_laplacian(nV, E, nE, EF, ELI, C, indptr, indices, L, diag_pos);
+    std::vector<double> A(L.size()), dinv(nV);
+    for (size_t q = 0; q < L.size(); ++q) A[q] = t * L[q];
+    for (i64 v = 0; v < nV; ++v) {
+        A[diag_pos[v]] += m[v];
+        dinv[v] = 1.0 / A[diag_pos[v]];
+    }
+    const size_t n6 = (size_t)nV * 6;
+    std::vector<double> Y(X, X + n6), R(n6), dY(n6);
+    std::fill(X, X + n6, 0.0);
+    *iterations = 0;
+    for (size_t j = 0; j < binom.size(); ++j) {
+        for (int s = 0; s < steps; ++s) {
+            // R = -t L Y
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+            for (i64 v = 0; v < nV; ++v) {
+                double acc[6] = {0, 0, 0, 0, 0, 0};
+                for (i64 q = indptr[v]; q < indptr[v + 1]; ++q) {
+                    const double a = L[q];
+                    const double* y = &Y[6 * (size_t)indices[q]];
+                    for (int c = 0; c < 6; ++c) acc[c] += a * y[c];
+                }
+                for (int c = 0; c < 6; ++c) R[6 * v + c] = -t * acc[c];
+            }
+            PCGResult res = block_pcg(nV, 6, indptr.data(), indices.data(), A.data(), nullptr, nullptr,
+                                      nullptr, dinv.data(), R.data(), dY.data(), rtol, maxiter, 0,
+                                      std::numeric_limits<double>::infinity(), nt);
+            *iterations += res.iterations;
+            if (res.status != 0) return res.status;
+            for (size_t q = 0; q < n6; ++q) Y[q] += std::isfinite(dY[q]) ? dY[q] : 0.0;
+        }
+        for (size_t q = 0; q < n6; ++q) X[q] += binom[j] * Y[q];
+    }
+    return 0;
+}
+
+}  // namespace hhj
