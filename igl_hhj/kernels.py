@@ -37,7 +37,7 @@ __all__ = [
     "topology", "hhj_system", "jump_apply", "block_pcg", "shape_operator_faces",
     "face_tensors", "lumped_vertex_recovery", "principal_2x2", "max_threads",
     "set_num_threads", "ell_indptr", "edge_morton_order", "recovery_weights", "patch_recovery",
-    "tangent_projection6", "smooth_vertex_tensors",
+    "tangent_projection6", "smooth_vertex_tensors", "face_metrics", "vertex_area_sums",
 ]
 
 
@@ -107,6 +107,23 @@ def topology(F, n_vertices):
     if F.ndim != 2 or F.shape[1] != 3:
         raise ValueError(f"F must have shape (#F, 3), got {F.shape}")
     return _core.topology(F, int(n_vertices))
+
+
+def face_metrics(V, F):
+    """One pass over the faces: ``(cross (#F, 3), double_areas (#F,), l2max (#F,))``, the
+    cross product ``(x1 - x0) × (x2 - x0)``, its norm and the squared longest edge.
+
+    Reference: :attr:`igl_hhj.mesh.TriangleMesh._cross`, ``face_double_areas`` and
+    :func:`igl_hhj.mesh.zero_area_faces`.  ``V`` (#V, 3) float64, ``F`` (#F, 3) int64
+    (validated indices)."""
+    _threads()
+    return _core.face_metrics(_f64(V, "V", (3,)), _i64(F))
+
+
+def vertex_area_sums(F, n_vertices, cross, double_areas):
+    """``(Σ_{T∋v} c_T (#V, 3), Σ_{T∋v} |c_T| (#V,))`` of :attr:`igl_hhj.mesh.TriangleMesh.folded_vertices`."""
+    return _core.vertex_area_sums(_i64(F), int(n_vertices), _f64(cross, "cross", (3,)),
+                                  _f64(double_areas, "double_areas"))
 
 
 def edge_morton_order(mesh):

@@ -86,7 +86,12 @@ def zero_area_faces(edge_vectors, double_areas):
     """
     with np.errstate(over="ignore", invalid="ignore"):
         l2max = (np.asarray(edge_vectors) ** 2).sum(axis=2).max(axis=1)
-        dbl = np.asarray(double_areas)
+        return _zero_area(np.asarray(double_areas), l2max)
+
+
+def _zero_area(dbl, l2max):
+    """The criterion of :func:`zero_area_faces` from twice the areas and the squared longest edges."""
+    with np.errstate(over="ignore", invalid="ignore"):
         return ~((dbl > DEGENERATE_AREA_RTOL * l2max) & np.isfinite(dbl) & np.isfinite(l2max))
 
 
@@ -401,10 +406,9 @@ class TriangleMesh:
         their normals cancel, as on a two-sided sheet (a triangle and its
         reverse), a sheet folded onto itself, the rim of a flat closed disc
         made of two fans, or a bow-tie vertex with opposite wings."""
-        corners = np.broadcast_to(self._cross[:, None, :], (self.n_faces, 3, 3))
-        s = np.linalg.norm(self.sum_corners_to_vertices(corners), axis=1)
-        a = self.sum_corners_to_vertices(np.broadcast_to(self.face_double_areas[:, None],
-                                                         (self.n_faces, 3)))
+        from . import kernels
+        s, a = kernels.vertex_area_sums(self.F, self.n_vertices, self._cross, self.face_double_areas)
+        s = np.linalg.norm(s, axis=1)
         return self.referenced_vertices & (s <= FOLDED_NORMAL_RTOL * a)
 
     def sum_corners_to_vertices(self, values):
@@ -430,9 +434,14 @@ class TriangleMesh:
 
     # ------------------------------------------------------------ checks
     def _check_degenerate(self):
+        # one compiled pass (igl_hhj.kernels.face_metrics) fills the caches of _cross and
+        # face_double_areas; reference: the numpy properties and zero_area_faces
+        from . import kernels
+        cross, dbl, l2max = kernels.face_metrics(self.V, self.F)
+        self.__dict__["_cross"] = cross
+        self.__dict__["face_double_areas"] = dbl
         with np.errstate(over="ignore", invalid="ignore"):
-            dbl = self.face_double_areas
-            bad = zero_area_faces(self._edge_vectors, dbl)
+            bad = _zero_area(dbl, l2max)
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
             n = int(bad.sum())
@@ -453,7 +462,7 @@ class TriangleMesh:
                 f"(area {area:.3g}, longest edge {longest:.3g}: relative area "
                 f"{2 * area / longest ** 2:.2g} ≤ {DEGENERATE_AREA_RTOL:g}, below what libigl's "
                 f"edge-length formulas resolve): collapse the short edge or remove the sliver")
-        h = float(np.sqrt((self._edge_vectors ** 2).sum(axis=2).max()))
+        h = float(np.sqrt(l2max.max()))
         if h < MIN_MESH_SIZE:
             raise ValueError(f"the mesh is too small: its longest edge is {h:.3g} < "
                              f"{MIN_MESH_SIZE:g} (squared areas underflow float64). Rescale it "
@@ -469,8 +478,8 @@ class TriangleMesh:
                 f"{e} between vertices {self.edges[e].tolist()} with {int(count[e])} faces")
         # On a consistently oriented manifold every interior edge is traversed
         # once in each direction.
-        pos = np.zeros(self.n_edges, dtype=np.int64)
-        np.add.at(pos, self.face_edges.ravel(), (self.face_edge_sign.ravel() > 0).astype(np.int64))
+        pos = np.bincount(self.face_edges.ravel(), weights=self.face_edge_sign.ravel() > 0,
+                          minlength=self.n_edges)
         bad = (count == 2) & (pos != 1)
         if bad.any():
             e = int(np.flatnonzero(bad)[0])

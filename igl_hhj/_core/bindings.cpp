@@ -73,6 +73,35 @@ NB_MODULE(_hhj_core, m) {
                               to_numpy(std::move(T.sign), {nf, 3}));
     }, "F"_a, "nV"_a);
 
+    m.def("face_metrics", [](In<double> V, In<i64> F) {
+        need(V.ndim() == 2 && V.shape(1) == 3 && F.ndim() == 2 && F.shape(1) == 3, "face_metrics: shapes");
+        const i64 nF = F.shape(0), nV = V.shape(0);
+        const i64* f = F.data();
+        for (i64 q = 0; q < 3 * nF; ++q) need(f[q] >= 0 && f[q] < nV, "face_metrics: index out of range");
+        std::vector<double> cross((size_t)nF * 3), dbl(nF), l2max(nF);
+        {
+            nb::gil_scoped_release nogil;
+            hhj::ThreadBudget tb(nF);
+            hhj::face_metrics(V.data(), F.data(), nF, cross.data(), dbl.data(), l2max.data(), tb.nt);
+        }
+        const size_t nf = nF;
+        return nb::make_tuple(to_numpy(std::move(cross), {nf, 3}), to_numpy(std::move(dbl), {nf}),
+                              to_numpy(std::move(l2max), {nf}));
+    });
+
+    m.def("vertex_area_sums", [](In<i64> F, i64 nV, In<double> cross, In<double> dbl) {
+        const i64 nF = F.shape(0);
+        need(cross.shape(0) == (size_t)nF && dbl.shape(0) == (size_t)nF, "vertex_area_sums: shapes");
+        const i64* f = F.data();
+        for (i64 q = 0; q < 3 * nF; ++q) need(f[q] >= 0 && f[q] < nV, "vertex_area_sums: index out of range");
+        std::vector<double> s((size_t)nV * 3), a(nV);
+        {
+            nb::gil_scoped_release nogil;
+            hhj::vertex_area_sums(F.data(), nF, nV, cross.data(), dbl.data(), s.data(), a.data());
+        }
+        return nb::make_tuple(to_numpy(std::move(s), {(size_t)nV, 3}), to_numpy(std::move(a), {(size_t)nV}));
+    });
+
     m.def("edge_morton_order", [](In<double> V, In<i64> E) {
         need(V.ndim() == 2 && V.shape(1) == 3 && E.ndim() == 2 && E.shape(1) == 2, "edge_morton_order: shapes");
         const i64 nE = E.shape(0);

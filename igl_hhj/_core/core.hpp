@@ -93,6 +93,9 @@ struct Topology {
 };
 void topology(const i64* F, i64 nF, i64 nV, Topology& out);
 void edge_morton_order(const double* V, i64 nV, const i64* E, i64 nE, i64* perm);
+void face_metrics(const double* V, const i64* F, i64 nF, double* cross, double* dbl, double* l2max, int nt);
+void vertex_area_sums(const i64* F, i64 nF, i64 nV, const double* cross, const double* dbl, double* s,
+                      double* a);
 
 // hhj_kernels.cpp
 void local_mass(const double* V, const i64* F, i64 nF, double* Aloc, double* sin_min = nullptr);

@@ -133,3 +133,47 @@ void edge_morton_order(const double* V, i64 nV, const i64* E, i64 nE, i64* perm)
 }
 
 }  // namespace hhj
+
+namespace hhj {
+
+// face_metrics: per face the cross product c = (x1 - x0) x (x2 - x0) (#F,3), twice the
+// area |c| (#F,) and the squared longest edge (#F,) (mesh.TriangleMesh._cross,
+// face_double_areas and the l2max of mesh.zero_area_faces), one pass.
+void face_metrics(const double* V, const i64* F, i64 nF, double* cross, double* dbl, double* l2max, int nt) {
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+    for (i64 f = 0; f < nF; ++f) {
+        const double* x[3] = {V + 3 * F[3 * f], V + 3 * F[3 * f + 1], V + 3 * F[3 * f + 2]};
+        double ev[3][3];  // edge i = x_{i+2} - x_{i+1}
+        for (int i = 0; i < 3; ++i)
+            for (int a = 0; a < 3; ++a) ev[i][a] = x[(i + 2) % 3][a] - x[(i + 1) % 3][a];
+        const double e1[3] = {x[1][0] - x[0][0], x[1][1] - x[0][1], x[1][2] - x[0][2]};
+        const double e2[3] = {x[2][0] - x[0][0], x[2][1] - x[0][1], x[2][2] - x[0][2]};
+        double* c = cross + 3 * f;
+        cross3(e1, e2, c);
+        dbl[f] = std::sqrt(dot3(c, c));
+        double m = 0.0;
+        for (int i = 0; i < 3; ++i) {
+            const double l2 = dot3(ev[i], ev[i]);
+            m = (l2 > m || std::isnan(l2)) ? l2 : m;
+        }
+        l2max[f] = m;
+    }
+}
+
+// vertex_area_sums: s[v] = sum_{T ∋ v} c_T (#V,3) and a[v] = sum_{T ∋ v} |c_T| (#V,), the
+// sums of mesh.TriangleMesh.folded_vertices; serial scatter in face order (deterministic).
+void vertex_area_sums(const i64* F, i64 nF, i64 nV, const double* cross, const double* dbl, double* s,
+                      double* a) {
+    std::fill(s, s + 3 * nV, 0.0);
+    std::fill(a, a + nV, 0.0);
+    for (i64 f = 0; f < nF; ++f)
+        for (int c = 0; c < 3; ++c) {
+            const i64 v = F[3 * f + c];
+            for (int k = 0; k < 3; ++k) s[3 * v + k] += cross[3 * f + k];
+            a[v] += dbl[f];
+        }
+}
+
+}  // namespace hhj
