@@ -62,12 +62,12 @@ class SolveInfo(dict):
 
 
 def _direct_seconds(n):
-    """Estimated time of one sparse Cholesky factorisation + solve of the HHJ matrix (n unknowns).
+    """Estimated time of one sparse factorisation + solve of the HHJ matrix (n unknowns).
 
-    Power-law fit of CHOLMOD times on this machine (single core; the "S_h direct"
-    column of ``python -m igl_hhj.benchmarks.speed``): ≈ 0.2 s at 34k unknowns
-    (camelhead), ≈ 1.4 s at 167k (bunny upsampled twice)."""
-    return 3.9e-7 * n ** 1.255
+    Power-law fit of :func:`factorize` on this machine (single core; the "S_h direct"
+    column of ``python -m igl_hhj.benchmarks.speed``): ≈ 0.1 s at 34k unknowns
+    (camelhead), ≈ 0.14 s at 58k (the open scan), ≈ 0.8–1 s at 123k–167k."""
+    return 1.1e-7 * n ** 1.3
 
 
 def _pcg_iter_seconds(n, k):
@@ -77,47 +77,77 @@ def _pcg_iter_seconds(n, k):
     return 1.2e-8 * n * (1 + k)
 
 
-def _splu_solve(A, R):
+# Below this many unknowns the direct solver is SuperLU in symmetric mode with a minimum-degree
+# ordering of A + Aᵀ (no pivoting: A is SPD); above, CHOLMOD's supernodal Cholesky.  Measured on
+# the HHJ matrices of the shared meshes (``--sliver-study`` meshes): SuperLU-MMD factorises
+# 10k–58k unknowns 1.6–1.9x faster than cholespy, and is 1.6x slower at 167k.
+LU_MMD_MAX = 80_000
+
+
+def _splu(A, pivot):
+    """SuperLU with the symmetric minimum-degree ordering; ``pivot`` False: no pivoting (SPD A)."""
     import scipy.sparse.linalg as spla
+    opts = {} if pivot else {"diag_pivot_thresh": 0.0, "options": {"SymmetricMode": True}}
     try:
-        return spla.splu(sp.csc_matrix(A)).solve(R)
+        return spla.splu(sp.csc_matrix(A), permc_spec="MMD_AT_PLUS_A", **opts).solve
     except RuntimeError as exc:
         raise SolverError(f"sparse LU failed: {exc}") from None
 
 
-def cholesky_solve(A, R, *, prefer_lu=False):
-    """Solve ``A X = R`` for SPD sparse A by one sparse factorisation.
+def _cholmod(A):
+    """CHOLMOD (cholespy) factorisation of SPD CSR A: a solve(R) callable, or None when
+    cholespy is missing or finds A not numerically positive definite."""
+    try:
+        from cholespy import CholeskySolverD, MatrixType
+        ch = CholeskySolverD(A.shape[0], A.indptr.astype(np.int32), A.indices.astype(np.int32),
+                             np.ascontiguousarray(A.data), MatrixType.CSR)
+    except (ImportError, ValueError, RuntimeError):
+        return None
 
-    Sparse Cholesky (CHOLMOD via cholespy); SuperLU (``scipy.sparse.linalg.splu``,
-    LU with partial pivoting) when cholespy is not available, when
-    ``prefer_lu`` is set (matrices known to be numerically semi-definite, e.g.
-    with faces of relative area ~1e-9) or when CHOLMOD finds the matrix not
-    numerically positive definite.  ``R`` (n,) or (n, k).  Raises
-    :class:`SolverError` when the factorisation fails or the solution is not finite."""
-    R = np.ascontiguousarray(R, dtype=np.float64)
-    n = A.shape[0]
-    if n == 0:
-        return np.zeros_like(R)
+    def solve(R, out=None):
+        X = np.empty_like(R) if out is None else out
+        ch.solve(R, X)
+        return X
+    return solve
+
+
+def factorize(A, *, prefer_lu=False, small_max=LU_MMD_MAX):
+    """One sparse factorisation of a symmetric positive (semi-)definite A: a ``solve(R)`` callable.
+
+    Up to ``small_max`` unknowns SuperLU without pivoting (:data:`LU_MMD_MAX`), above
+    CHOLMOD; LU with partial pivoting when ``prefer_lu`` is set (matrices known to be
+    numerically semi-definite, e.g. with faces of relative area ~1e-9) or when the
+    first choice fails.  ``R`` (n, k) C-contiguous float64."""
     A = sp.csr_matrix(A)
     if not A.has_canonical_format:
         A = A.copy()          # sum_duplicates works in place: leave the caller's matrix alone
         A.sum_duplicates()
-    try:
-        from cholespy import CholeskySolverD, MatrixType
-    except ImportError:  # pragma: no cover - cholespy is a dependency
-        prefer_lu = True
-    X = None
     if not prefer_lu:
-        try:
-            solver = CholeskySolverD(n, A.indptr.astype(np.int32), A.indices.astype(np.int32),
-                                     np.ascontiguousarray(A.data), MatrixType.CSR)
-        except (ValueError, RuntimeError):
-            X = None          # not numerically positive definite: LU below
+        fn = None
+        if A.shape[0] <= small_max:
+            try:
+                fn = _splu(A, pivot=False)
+            except SolverError:
+                fn = None
         else:
-            X = np.empty_like(R)
-            solver.solve(R, X)
-    if X is None:
-        X = _splu_solve(A, R)
+            fn = _cholmod(A)
+        if fn is not None:
+            return fn
+    return _splu(A, pivot=True)
+
+
+def cholesky_solve(A, R, *, prefer_lu=False):
+    """Solve ``A X = R`` for SPD sparse A by one sparse factorisation (:func:`factorize`).
+
+    ``R`` (n,) or (n, k).  Raises :class:`SolverError` when the factorisation fails or
+    the solution is not finite (after retrying with pivoted LU)."""
+    R = np.ascontiguousarray(R, dtype=np.float64)
+    n = A.shape[0]
+    if n == 0:
+        return np.zeros_like(R)
+    X = factorize(A, prefer_lu=prefer_lu)(R)
+    if not np.isfinite(X).all() and not prefer_lu:
+        X = factorize(A, prefer_lu=True)(R)
     if not np.isfinite(X).all():
         raise SolverError("the sparse direct solve produced non-finite values (matrix numerically singular)")
     return X
@@ -217,26 +247,18 @@ class HHJSystem:
         when A_SS cannot be factorised (numerically singular faces: face-Schwarz alone)."""
         A = self.csr()[S][:, S].tocsr()
         A.sum_duplicates()
-        if self.n_jacobi_faces > 0:
-            # numerically singular face blocks: LU with pivoting (CHOLMOD would refuse)
-            import scipy.sparse.linalg as spla
-            try:
-                lu = spla.splu(sp.csc_matrix(A))
-            except RuntimeError:
-                return None
-
-            def solve_lu(r, z):
-                z[...] = lu.solve(r)
-            return solve_lu
+        # CHOLMOD: its solves are ~3x faster than SuperLU's, and the two-level applies
+        # one per PCG iteration; pivoted LU where A_SS is numerically semi-definite
+        chol = _cholmod(A)
+        if chol is not None:
+            return lambda r, z: chol(r, out=z)
         try:
-            from cholespy import CholeskySolverD, MatrixType
-            ch = CholeskySolverD(len(S), A.indptr.astype(np.int32), A.indices.astype(np.int32),
-                                 np.ascontiguousarray(A.data), MatrixType.CSR)
-        except (ImportError, ValueError, RuntimeError):
+            lu = _splu(A, pivot=True)
+        except SolverError:
             return None
 
         def solve(r, z):
-            ch.solve(r, z)
+            z[...] = lu(r)
         return solve
 
     def csr(self):

@@ -92,6 +92,45 @@ void update_k(i64 n, int kr, const double* alpha_in, double* X, double* r, const
     }
 }
 
+// Jacobi variant: also partial sums of r.(dinv r) (the next r.z) into P2, so that z = dinv r
+// is never stored (same operations as update_k + apply_and_dot_k with dinv: same bits).
+template <int K>
+void update_jacobi_k(i64 n, int kr, const double* alpha_in, double* X, double* r, const double* p,
+                     const double* q, const double* dinv, Partials& P, Partials& P2, int nt) {
+    const int k = K ? K : kr;
+    double alpha[16];
+    for (int j = 0; j < k; ++j) alpha[j] = alpha_in[j];
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+    for (i64 c = 0; c < P.nch; ++c) {
+        const i64 r0 = c * CHUNK, r1 = std::min(n, r0 + CHUNK);
+        double acc[16] = {0}, acc2[16] = {0};
+        for (i64 i = r0; i < r1; ++i) {
+            const double di = dinv[i];
+            for (int j = 0; j < k; ++j) {
+                const size_t s = (size_t)i * k + j;
+                X[s] += alpha[j] * p[s];
+                const double rs = r[s] - alpha[j] * q[s];
+                r[s] = rs;
+                acc[j] += rs * rs;
+                acc2[j] += rs * (di * rs);
+            }
+        }
+        for (int j = 0; j < k; ++j) { P.buf[(size_t)c * k + j] = acc[j]; P2.buf[(size_t)c * k + j] = acc2[j]; }
+    }
+}
+
+void update_jacobi(i64 n, int k, const double* alpha, double* X, double* r, const double* p, const double* q,
+                   const double* dinv, Partials& P, Partials& P2, int nt) {
+    switch (k) {
+        case 1: update_jacobi_k<1>(n, k, alpha, X, r, p, q, dinv, P, P2, nt); break;
+        case 3: update_jacobi_k<3>(n, k, alpha, X, r, p, q, dinv, P, P2, nt); break;
+        case 6: update_jacobi_k<6>(n, k, alpha, X, r, p, q, dinv, P, P2, nt); break;
+        default: update_jacobi_k<0>(n, k, alpha, X, r, p, q, dinv, P, P2, nt);
+    }
+}
+
 void update(i64 n, int k, const double* alpha, double* X, double* r, const double* p, const double* q,
             Partials& P, int nt) {
     switch (k) {
@@ -118,7 +157,9 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
     PCGResult res;
     res.relres.assign(k, 0.0);
     double* r = R;  // R becomes the residual (caller's scratch: no copy of n x k)
-    std::vector<double> z((size_t)n * k), p((size_t)n * k), q((size_t)n * k);
+    // Jacobi without a second level: z = dinv r is fused into the update and p sweeps
+    const bool fused = Mp == nullptr && !(sub && sub->nS > 0);
+    std::vector<double> z(fused ? 0 : (size_t)n * k), p((size_t)n * k), q((size_t)n * k);
     std::fill(X, X + (size_t)n * k, 0.0);
     Partials P(n, k);
     std::vector<double> bb(k), rr(k), rz(k), rz_new(k), pq(k), alpha(k), beta(k), tol2(k);
@@ -151,7 +192,7 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
     // z = M r (+ R_S^T C R_S r), out = r.z; the second level's share of r.z is summed
     // serially over S in a fixed order (deterministic).
     auto precondition = [&](std::vector<double>& out) {
-        apply_and_dot(n, k, Mp, Mi, Mx, dinv, r, z.data(), r, P, nt);
+        apply_and_dot(n, k, Mp, Mi, Mx, dinv, r, fused ? p.data() : z.data(), r, P, nt);
         P.reduce(out);
         if (rS.empty()) return;
         for (i64 i = 0; i < sub->nS; ++i)
@@ -164,8 +205,9 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
                 out[j] += rS[(size_t)i * k + j] * zS[(size_t)i * k + j];
             }
     };
-    precondition(rz);
-    std::copy(z.begin(), z.end(), p.begin());
+    precondition(rz);   // fused: p = dinv r directly
+    if (!fused) std::copy(z.begin(), z.end(), p.begin());
+    Partials P2(n, k);
     res.status = 1;
     for (i64 it = 1; it <= maxiter; ++it) {
         apply_and_dot(n, k, Ap, Ai, Ax, nullptr, p.data(), q.data(), p.data(), P, nt);
@@ -176,7 +218,12 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
             breakdown = breakdown || (active[j] && !(pq[j] > 0.0 && std::isfinite(alpha[j])));
         }
         if (breakdown) { res.status = 3; res.iterations = it; break; }
-        update(n, k, alpha.data(), X, r, p.data(), q.data(), P, nt);
+        if (fused) {
+            update_jacobi(n, k, alpha.data(), X, r, p.data(), q.data(), dinv, P, P2, nt);
+            P2.reduce(rz_new);
+        } else {
+            update(n, k, alpha.data(), X, r, p.data(), q.data(), P, nt);
+        }
         P.reduce(rr);
         res.iterations = it;
         any = false;
@@ -199,7 +246,7 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
                 res.status = 2; break;
             }
         }
-        precondition(rz_new);
+        if (!fused) precondition(rz_new);
         for (int j = 0; j < k; ++j) {
             beta[j] = active[j] ? rz_new[j] / rz[j] : 0.0;
             rz[j] = rz_new[j];
@@ -212,6 +259,16 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
             double b[16];
             for (int j = 0; j < k; ++j) b[j] = beta[j];
             double* pp = p.data();
+            if (fused) {
+                for (i64 i = r0; i < r1; ++i) {
+                    const double di = dinv[i];
+                    for (int j = 0; j < k; ++j) {
+                        const size_t s = (size_t)i * k + j;
+                        pp[s] = di * r[s] + b[j] * pp[s];
+                    }
+                }
+                continue;
+            }
             const double* zz = z.data();
             for (i64 i = r0; i < r1; ++i)
                 for (int j = 0; j < k; ++j) {
