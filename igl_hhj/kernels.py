@@ -204,7 +204,7 @@ def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,
     X : (n, k) float64
     iterations : int
     status : int, 0 converged, 1 reached maxiter, 2 stopped early because the
-        extrapolated iteration count exceeded ``max_predicted`` (checked every
+        extrapolated number of iterations still needed exceeded ``max_predicted`` (checked every
         ``probe_iter`` iterations), 3 breakdown (``pᵀAp ≤ 0`` or the residual grew
         10⁴-fold: the matrix is numerically singular or not SPD)
     relres : list of float, final relative residual per column

@@ -12,8 +12,8 @@ Three ways to solve, chosen per call:
   400–800 iterations (camelhead 811, bunny upsampled twice 417); with it 40–60.
 * ``"auto"`` (default): direct below :data:`AUTO_DIRECT_MAX` unknowns; otherwise
   the same PCG, which checks its convergence rate every :data:`PROBE_ITER`
-  iterations and, when the extrapolated iteration count would cost more than the
-  estimated factorisation (:func:`_direct_seconds`), stops and factorises instead.
+  iterations and, when the iterations still needed (extrapolated from the rate so far)
+  would cost more than the estimated factorisation (:func:`_direct_seconds`), stops and factorises instead.
   Above :data:`DIRECT_MAX` unknowns (memory) PCG always runs to the end.
 
 Tolerance
@@ -62,19 +62,21 @@ class SolveInfo(dict):
 
 
 def _direct_seconds(n):
-    """Estimated time of one sparse factorisation + solve of the HHJ matrix (n unknowns).
-
-    Power-law fit of :func:`factorize` on this machine (single core; the "S_h direct"
-    column of ``python -m igl_hhj.benchmarks.speed``): ≈ 0.1 s at 34k unknowns
-    (camelhead), ≈ 0.14 s at 58k (the open scan), ≈ 0.8–1 s at 123k–167k."""
-    return 1.1e-7 * n ** 1.3
+    """Estimated time of one sparse factorisation + solve of the HHJ matrix (n unknowns) by
+    :func:`factorize`: power-law fits on this machine (``python -m igl_hhj.benchmarks.speed``,
+    "S_h direct"): SuperLU-MMD up to :data:`LU_MMD_MAX` (≈ 0.1 s at 34k unknowns, camelhead;
+    0.14 s at 58k, the open scan), CHOLMOD above (≈ 0.8 s at 123k, 2.9 s at 393k)."""
+    if n <= LU_MMD_MAX:
+        return 1.1e-7 * n ** 1.3
+    return 3.9e-7 * n ** 1.255
 
 
 def _pcg_iter_seconds(n, k):
-    """Estimated time of one fused PCG iteration (n unknowns, k right-hand sides);
-    ≈ 0.1 s for 7 iterations at 1.97M unknowns, k = 3, single core
-    (``python -m igl_hhj.benchmarks.speed --profile 'icosphere(8)'``: PCG 0.71 s)."""
-    return 1.2e-8 * n * (1 + k)
+    """Estimated time of one fused PCG iteration (n unknowns, k right-hand sides), face-Schwarz
+    level only: ≈ 1 ms at 34k unknowns with the sliver level (camelhead), 8.5 ms at 393k
+    (Walker's sliver torus), 2 threads (``--sliver-study``; the two-level adds
+    ``2|S|/n`` of this, see :meth:`HHJSystem._pcg`)."""
+    return 0.6e-8 * n * (1 + k)
 
 
 # Below this many unknowns the direct solver is SuperLU in symmetric mode with a minimum-degree
@@ -85,11 +87,15 @@ LU_MMD_MAX = 80_000
 
 
 def _splu(A, pivot):
-    """SuperLU with the symmetric minimum-degree ordering; ``pivot`` False: no pivoting (SPD A)."""
+    """SuperLU: ``pivot`` False, symmetric mode (no pivoting, for SPD A) with the minimum-degree
+    ordering of A + Aᵀ; ``pivot`` True, partial pivoting with SuperLU's default COLAMD ordering
+    (with pivoting the symmetric ordering loses its sparsity: 30 s instead of 0.25 s on the
+    open scan)."""
     import scipy.sparse.linalg as spla
-    opts = {} if pivot else {"diag_pivot_thresh": 0.0, "options": {"SymmetricMode": True}}
+    opts = {"permc_spec": "MMD_AT_PLUS_A", "diag_pivot_thresh": 0.0,
+            "options": {"SymmetricMode": True}} if not pivot else {}
     try:
-        return spla.splu(sp.csc_matrix(A), permc_spec="MMD_AT_PLUS_A", **opts).solve
+        return spla.splu(sp.csc_matrix(A), **opts).solve
     except RuntimeError as exc:
         raise SolverError(f"sparse LU failed: {exc}") from None
 
@@ -301,7 +307,7 @@ class HHJSystem:
         budget = np.inf
         if n <= DIRECT_MAX:
             per_iter = _pcg_iter_seconds(n, k) * (1.0 + 2.0 * len(S) / n)
-            budget = _direct_seconds(n) / per_iter
+            budget = _direct_seconds(n) / per_iter      # PCG iterations still worth doing
         # rhs is this solve's private (permuted) copy: PCG uses it as its residual buffer
         overwrite = rhs.shape[1] <= 16 and rhs.flags.c_contiguous and rhs.dtype == np.float64
         X, it, status, relres = pcg(self.indptr, self._cols_flat, self.A.ravel(), rhs,

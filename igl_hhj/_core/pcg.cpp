@@ -146,8 +146,9 @@ void update(i64 n, int k, const double* alpha, double* X, double* r, const doubl
 // (R is overwritten by the final residual),
 // preconditioner M in CSR (Mp, Mi, Mx) or, with Mp == nullptr, Jacobi dinv (n,).
 // Column j stops when |r_j| <= rtol |R_j|.  Every probe_iter iterations (0: never) the
-// iterations still needed are extrapolated from the mean rate so far; above
-// max_predicted the solve stops early (status 2) so the caller can switch solvers.
+// iterations still needed are extrapolated from the mean rate so far; when more than
+// max_predicted would remain, the solve stops early (status 2) so the caller can switch
+// solvers.
 // Status 3: breakdown (p.Ap <= 0 or the residual grew 1e4-fold: A numerically singular).
 PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const double* Ax,
                     const i64* Mp, const std::int32_t* Mi, const double* Mx, const double* dinv,
@@ -240,8 +241,8 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
             for (int j = 0; j < k; ++j)
                 if (active[j] && bb[j] > 0) worst = std::max(worst, std::sqrt(rr[j] / bb[j]));
             if (worst > 0 && worst < 1) {
-                const double predicted = (double)it * std::log(rtol) / std::log(worst);
-                if (predicted > max_predicted) { res.status = 2; break; }
+                const double remaining = (double)it * std::log(rtol) / std::log(worst) - (double)it;
+                if (remaining > max_predicted) { res.status = 2; break; }
             } else if (worst >= 1) {
                 res.status = 2; break;
             }
