@@ -280,3 +280,96 @@ def test_missing_extension_is_an_import_error_naming_the_fix():
             "try:\n    from igl_hhj import kernels\nexcept ImportError as e:\n    print(e)\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert "compiled core" in out.stdout and "C++17 compiler" in out.stdout
+
+
+# --------------------------------------------------------------------------- vertex stage
+def _vertex_stage_meshes():
+    out = _meshes()
+    V, F = _bumpy()
+    out["unreferenced"] = (np.vstack([V, [[5.0, 5.0, 5.0]]]), F)    # a vertex no face uses
+    return out
+
+
+@pytest.mark.parametrize("name", ["closed", "open", "sliver", "unreferenced"])
+@pytest.mark.parametrize("smoothing", [0, 2, 5])
+def test_vertex_stage_equals_numpy_reference(name, smoothing):
+    """The compiled patch recovery + smoothing (recovery.recover_and_smooth) equals the numpy
+    reference (recover_vertex_tensors + smooth_vertex_tensors), NaN rows included."""
+    from igl_hhj.curvature import _vertex_shape_operator_numpy, vertex_shape_operator
+    m = TriangleMesh(*_vertex_stage_meshes()[name])
+    S = _shape_operator(m, None, None, None, "direct")
+    Sv, N = vertex_shape_operator(m, S, smoothing=smoothing)
+    Sr, Nr = _vertex_shape_operator_numpy(m, S, smoothing=smoothing)
+    ref = m.referenced_vertices
+    assert np.array_equal(np.isnan(Sv).any(axis=(1, 2)), ~ref)
+    assert np.array_equal(np.isnan(Sr).any(axis=(1, 2)), ~ref)
+    assert rel(Sv[ref], Sr[ref]) <= RTOL and np.array_equal(N, Nr, equal_nan=True)
+
+
+def test_recovery_kernels_equal_reference(closed):
+    from igl_hhj import recovery as rc
+    m = TriangleMesh(*_sliver_mesh())
+    for mesh in (closed, m):
+        w = kernels.recovery_weights(mesh, rc.QUALITY_FLOOR)
+        assert rel(w, rc.recovery_weights(mesh)) <= 1e-13
+        S = _shape_operator(mesh, None, None, None, "direct")
+        X = kernels.patch_recovery(mesh, S, mesh.vertex_normals, w)
+        Sv, _ = rc.recover_vertex_tensors(mesh, S, weights=w)
+        assert rel(rc._from6(X), Sv) <= 1e-13
+    cross, dbl, l2max = kernels.face_metrics(closed.V, closed.F)
+    ev = closed._edge_vectors
+    np.testing.assert_allclose(cross, np.cross(ev[:, 2], -ev[:, 1]), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(dbl, np.linalg.norm(cross, axis=1), rtol=1e-15)
+    np.testing.assert_allclose(l2max, (ev ** 2).sum(axis=2).max(axis=1), rtol=1e-15)
+
+
+def test_smoothing_falls_back_to_the_reference_when_a_solve_stalls(closed, monkeypatch):
+    from igl_hhj import recovery as rc
+    S = _shape_operator(closed, None, None, None, "direct")
+    length = rc.smoothing_length(closed, 5)
+    good, _ = rc.recover_and_smooth(closed, S, length)
+    monkeypatch.setattr(kernels, "smooth_vertex_tensors", lambda *a, **k: (1, 500))
+    fallback, _ = rc.recover_and_smooth(closed, S, length)
+    assert rel(fallback, good) <= RTOL
+
+
+def test_fused_jacobi_pcg_equals_csr_preconditioner(closed):
+    """Jacobi is fused into the PCG sweeps (no z vector); the same preconditioner as an
+    explicit diagonal CSR matrix runs the unfused code path: the bits must agree."""
+    import igl
+    K = sp.csr_matrix(-igl.cotmatrix(closed.V, closed.F) + sp.diags(np.full(closed.n_vertices, 1e-2)))
+    K.sort_indices()
+    R = np.random.default_rng(7).normal(size=(K.shape[0], 6))
+    dinv = 1.0 / K.diagonal()
+    D = sp.diags(dinv).tocsr()
+    a = kernels.block_pcg(K.indptr, K.indices, K.data, R, rtol=1e-10, maxiter=2000, dinv=dinv)
+    b = kernels.block_pcg(K.indptr, K.indices, K.data, R, rtol=1e-10, maxiter=2000,
+                          M=(D.indptr, D.indices, D.data))
+    assert a[1] == b[1] and a[2] == b[2] == 0 and np.array_equal(a[0], b[0])
+
+
+def test_vertex_stage_bit_identical_across_thread_counts():
+    from igl_hhj import recovery as rc
+    m = TriangleMesh(*_bumpy(5))
+    S = _shape_operator(m, None, None, None, "cg", 1e-10)
+    nt = kernels.max_threads()
+    adapt, kernels.ADAPT_TO_LOAD = kernels.ADAPT_TO_LOAD, False
+    try:
+        kernels.set_num_threads(1)
+        one, _ = rc.recover_and_smooth(m, S, rc.smoothing_length(m, 5))
+        kernels.set_num_threads(max(2, nt))
+        two, _ = rc.recover_and_smooth(m, S, rc.smoothing_length(m, 5))
+    finally:
+        kernels.set_num_threads(nt)
+        kernels.ADAPT_TO_LOAD = adapt
+    assert np.array_equal(one, two)
+
+
+def test_vertex_kernels_reject_bad_arrays(closed):
+    S = np.zeros((closed.n_faces, 3, 3))
+    with pytest.raises(ValueError, match="patch_recovery"):
+        kernels.patch_recovery(closed, S[:-1], closed.vertex_normals, closed.face_areas)
+    X = np.zeros((closed.n_vertices, 5))
+    with pytest.raises(ValueError, match="smooth_vertex_tensors"):
+        kernels.smooth_vertex_tensors(closed, X, np.zeros((closed.n_faces, 3)),
+                                      np.ones(closed.n_vertices), 1.0, 2, [2, -1], 1e-3, 10)
