@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from typing import Any
 
+import igl  # noqa: F401  (imported with the public API, not inside the first call: issue 16)
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 

@@ -2,8 +2,9 @@
 
 Three ways to solve, chosen per call:
 
-* ``"direct"``: sparse Cholesky (CHOLMOD through ``cholespy``; SuperLU when
-  cholespy is not importable), one factorisation for all right-hand sides.
+* ``"direct"``: one sparse factorisation for all right-hand sides (:func:`factorize`):
+  SuperLU in symmetric mode with a minimum-degree ordering up to :data:`LU_MMD_MAX`
+  unknowns, CHOLMOD (``cholespy``) above.
 * ``"cg"``: the compiled fused block PCG (:func:`igl_hhj.kernels.block_pcg`),
   preconditioned by a two-level method: the face-Schwarz preconditioner (exact
   inverses of every face's 3×3 block of A) plus an exact sparse Cholesky solve on
@@ -33,6 +34,12 @@ import time
 
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+try:  # imported here, not in the first solve (first call ≈ later calls, issue 16)
+    from cholespy import CholeskySolverD, MatrixType
+except ImportError:  # pragma: no cover - cholespy is a dependency
+    CholeskySolverD = MatrixType = None
 
 from . import kernels
 from .errors import SolverDidNotConverge, SolverError
@@ -91,7 +98,6 @@ def _splu(A, pivot):
     ordering of A + Aᵀ; ``pivot`` True, partial pivoting with SuperLU's default COLAMD ordering
     (with pivoting the symmetric ordering loses its sparsity: 30 s instead of 0.25 s on the
     open scan)."""
-    import scipy.sparse.linalg as spla
     opts = {"permc_spec": "MMD_AT_PLUS_A", "diag_pivot_thresh": 0.0,
             "options": {"SymmetricMode": True}} if not pivot else {}
     try:
@@ -103,11 +109,12 @@ def _splu(A, pivot):
 def _cholmod(A):
     """CHOLMOD (cholespy) factorisation of SPD CSR A: a solve(R) callable, or None when
     cholespy is missing or finds A not numerically positive definite."""
+    if CholeskySolverD is None:  # pragma: no cover
+        return None
     try:
-        from cholespy import CholeskySolverD, MatrixType
         ch = CholeskySolverD(A.shape[0], A.indptr.astype(np.int32), A.indices.astype(np.int32),
                              np.ascontiguousarray(A.data), MatrixType.CSR)
-    except (ImportError, ValueError, RuntimeError):
+    except (ValueError, RuntimeError):
         return None
 
     def solve(R, out=None):

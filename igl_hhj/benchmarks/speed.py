@@ -17,8 +17,9 @@ For each mesh it prints: the smallest angle; the best-of-``--repeat`` wall time 
 never be slower than both); what "auto" chose and its PCG iterations; the peak memory of
 one drop-in call above the input (KB per face, in a fresh subprocess after a warm-up call
 on a tiny mesh: the peak resident size ``VmHWM``, reset just before the call, minus the
-resident size before it) and how much slower
-the first call in a fresh process is than the best later one.  Writes ``speed.md`` to
+resident size before it), how much slower
+the first call in a fresh process is than the best later one, and the time of
+``from igl_hhj import principal_curvature`` there (which imports what the call needs).  Writes ``speed.md`` to
 ``--out``.
 """
 from __future__ import annotations
@@ -128,7 +129,7 @@ def _best(fn, repeat):
 _CHILD_TIME = r"""
 import json, sys, time
 import numpy as np
-t = time.perf_counter(); import igl_hhj; t_import = time.perf_counter() - t
+t = time.perf_counter(); import igl_hhj; from igl_hhj import principal_curvature; t_import = time.perf_counter() - t
 d = np.load(sys.argv[1]); V, F = d["V"], d["F"]
 t = time.perf_counter(); igl_hhj.principal_curvature(V, F); first = time.perf_counter() - t
 later = float("inf")
@@ -329,7 +330,7 @@ def profile_stages(V, F, rtol=None):
 def markdown(rows):
     head = ["mesh", "faces", "min angle", "libigl (s)", "drop-in (s)", "ratio", "µs/face",
             "S_h direct (s)", "S_h cg (s)", "S_h auto (s)", "auto chose", "PCG its",
-            "peak KB/face", "1st call / later"]
+            "peak KB/face", "1st call / later", "import (s)"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     f3 = lambda x: "–" if not np.isfinite(x) else f"{x:.3f}"  # noqa: E731
     for r in rows:
@@ -338,7 +339,8 @@ def markdown(rows):
                  f"{1e6 * r['dropin'] / r['faces']:.2f}", f3(r["S_direct"]), f3(r["S_cg"]),
                  f3(r["S_auto"]), r["chosen"], str(r["iterations"]),
                  f"{r['kb_per_face']:.2f}" if "kb_per_face" in r else "–",
-                 f"{r['first_over_later']:.2f}" if "first_over_later" in r else "–"]
+                 f"{r['first_over_later']:.2f}" if "first_over_later" in r else "–",
+                 f"{r['import']:.2f}" if "import" in r else "–"]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
