@@ -62,6 +62,32 @@ inline void cross3(const double* a, const double* b, double* c) {
 }
 inline double dot3(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
+// Tangent frame of a unit normal n: e1 = n x a / |n x a| (a = the first coordinate axis
+// least aligned with n), e2 = n x e1 (recovery.recovery_operator, curvature's 2x2 eigen).
+inline void tangent_frame(const double* n, double e1[3], double e2[3]) {
+    int ax = 0;
+    double best = std::fabs(n[0]);
+    for (int a = 1; a < 3; ++a)
+        if (std::fabs(n[a]) < best) { best = std::fabs(n[a]); ax = a; }
+    double axis[3] = {0, 0, 0};
+    axis[ax] = 1.0;
+    cross3(n, axis, e1);
+    const double ne = std::sqrt(dot3(e1, e1));
+    for (int a = 0; a < 3; ++a) e1[a] /= ne;
+    cross3(n, e1, e2);
+}
+
+// out = P S P, P = I - n n^T (projection of a 3x3 tensor onto the tangent plane of unit n)
+inline void project_tangent(const double* n, const double S[3][3], double out[3][3]) {
+    double P[3][3], T[3][3];
+    for (int p = 0; p < 3; ++p)
+        for (int q = 0; q < 3; ++q) P[p][q] = (p == q ? 1.0 : 0.0) - n[p] * n[q];
+    for (int p = 0; p < 3; ++p)
+        for (int q = 0; q < 3; ++q) T[p][q] = P[p][0] * S[0][q] + P[p][1] * S[1][q] + P[p][2] * S[2][q];
+    for (int p = 0; p < 3; ++p)
+        for (int q = 0; q < 3; ++q) out[p][q] = T[p][0] * P[0][q] + T[p][1] * P[1][q] + T[p][2] * P[2][q];
+}
+
 // Face geometry of face f of (V, F), same formulas as mesh.py's properties.
 inline void face_geom(const double* V, const i64* F, i64 f, FaceGeom& g) {
     const double* x[3] = {V + 3 * F[3 * f], V + 3 * F[3 * f + 1], V + 3 * F[3 * f + 2]};

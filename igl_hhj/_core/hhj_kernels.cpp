@@ -243,16 +243,10 @@ void lumped_vertex_recovery(const double* V, const i64* F, i64 nF, i64 nV, const
         }
     }
     for (i64 v = 0; v < nV; ++v) {
-        double M[3][3], P[3][3], T[3][3];
+        double M[3][3], U[3][3];
         for (int p = 0; p < 9; ++p) M[p / 3][p % 3] = acc[9 * v + p] / w[v];
-        const double* n = N + 3 * v;
-        for (int p = 0; p < 3; ++p)
-            for (int q = 0; q < 3; ++q) P[p][q] = (p == q ? 1.0 : 0.0) - n[p] * n[q];
-        for (int p = 0; p < 3; ++p)
-            for (int q = 0; q < 3; ++q) T[p][q] = P[p][0] * M[0][q] + P[p][1] * M[1][q] + P[p][2] * M[2][q];
-        for (int p = 0; p < 3; ++p)
-            for (int q = 0; q < 3; ++q)
-                Sv[9 * v + 3 * p + q] = T[p][0] * P[0][q] + T[p][1] * P[1][q] + T[p][2] * P[2][q];
+        project_tangent(N + 3 * v, M, U);
+        for (int p = 0; p < 9; ++p) Sv[9 * v + p] = U[p / 3][p % 3];
     }
 }
 
@@ -267,17 +261,8 @@ void principal_2x2(const double* S, const double* N, i64 n, double* PD1, double*
     for (i64 r = 0; r < n; ++r) {
         const double* nv = N + 3 * r;
         const double* M = S + 9 * r;
-        int ax = 0;
-        double best = std::fabs(nv[0]);
-        for (int a = 1; a < 3; ++a)
-            if (std::fabs(nv[a]) < best) { best = std::fabs(nv[a]); ax = a; }
-        double axis[3] = {0, 0, 0};
-        axis[ax] = 1.0;
         double e1[3], e2[3];
-        cross3(nv, axis, e1);
-        const double ne = std::sqrt(dot3(e1, e1));
-        for (int a = 0; a < 3; ++a) e1[a] /= ne;
-        cross3(nv, e1, e2);
+        tangent_frame(nv, e1, e2);
         double Se1[3], Se2[3];
         for (int p = 0; p < 3; ++p) {
             Se1[p] = M[3 * p] * e1[0] + M[3 * p + 1] * e1[1] + M[3 * p + 2] * e1[2];

@@ -67,36 +67,12 @@ void apply_and_dot(i64 n, int k, const i64* p, const std::int32_t* idx, const do
     }
 }
 
-// X += alpha p; r -= alpha q; partial sums of r.r per chunk
-template <int K>
+// X += alpha p; r -= alpha q; partial sums of r.r per chunk.  JACOBI: also partial sums
+// of r.(dinv r) (the next r.z) into P2, so that z = dinv r is never stored (the same
+// operations as apply_and_dot_k with dinv: the same bits).
+template <int K, bool JACOBI>
 void update_k(i64 n, int kr, const double* alpha_in, double* X, double* r, const double* p,
-              const double* q, Partials& P, int nt) {
-    const int k = K ? K : kr;
-    double alpha[16];
-    for (int j = 0; j < k; ++j) alpha[j] = alpha_in[j];
-#ifdef IGL_HHJ_OPENMP
-#pragma omp parallel for schedule(static) num_threads(nt)
-#endif
-    for (i64 c = 0; c < P.nch; ++c) {
-        const i64 r0 = c * CHUNK, r1 = std::min(n, r0 + CHUNK);
-        double acc[16] = {0};
-        for (i64 i = r0; i < r1; ++i)
-            for (int j = 0; j < k; ++j) {
-                const size_t s = (size_t)i * k + j;
-                X[s] += alpha[j] * p[s];
-                const double rs = r[s] - alpha[j] * q[s];
-                r[s] = rs;
-                acc[j] += rs * rs;
-            }
-        for (int j = 0; j < k; ++j) P.buf[(size_t)c * k + j] = acc[j];
-    }
-}
-
-// Jacobi variant: also partial sums of r.(dinv r) (the next r.z) into P2, so that z = dinv r
-// is never stored (same operations as update_k + apply_and_dot_k with dinv: same bits).
-template <int K>
-void update_jacobi_k(i64 n, int kr, const double* alpha_in, double* X, double* r, const double* p,
-                     const double* q, const double* dinv, Partials& P, Partials& P2, int nt) {
+              const double* q, const double* dinv, Partials& P, Partials* P2, int nt) {
     const int k = K ? K : kr;
     double alpha[16];
     for (int j = 0; j < k; ++j) alpha[j] = alpha_in[j];
@@ -107,37 +83,39 @@ void update_jacobi_k(i64 n, int kr, const double* alpha_in, double* X, double* r
         const i64 r0 = c * CHUNK, r1 = std::min(n, r0 + CHUNK);
         double acc[16] = {0}, acc2[16] = {0};
         for (i64 i = r0; i < r1; ++i) {
-            const double di = dinv[i];
+            const double di = JACOBI ? dinv[i] : 0.0;
             for (int j = 0; j < k; ++j) {
                 const size_t s = (size_t)i * k + j;
                 X[s] += alpha[j] * p[s];
                 const double rs = r[s] - alpha[j] * q[s];
                 r[s] = rs;
                 acc[j] += rs * rs;
-                acc2[j] += rs * (di * rs);
+                if (JACOBI) acc2[j] += rs * (di * rs);
             }
         }
-        for (int j = 0; j < k; ++j) { P.buf[(size_t)c * k + j] = acc[j]; P2.buf[(size_t)c * k + j] = acc2[j]; }
+        for (int j = 0; j < k; ++j) P.buf[(size_t)c * k + j] = acc[j];
+        if (JACOBI)
+            for (int j = 0; j < k; ++j) P2->buf[(size_t)c * k + j] = acc2[j];
     }
 }
 
-void update_jacobi(i64 n, int k, const double* alpha, double* X, double* r, const double* p, const double* q,
-                   const double* dinv, Partials& P, Partials& P2, int nt) {
-    switch (k) {
-        case 1: update_jacobi_k<1>(n, k, alpha, X, r, p, q, dinv, P, P2, nt); break;
-        case 3: update_jacobi_k<3>(n, k, alpha, X, r, p, q, dinv, P, P2, nt); break;
-        case 6: update_jacobi_k<6>(n, k, alpha, X, r, p, q, dinv, P, P2, nt); break;
-        default: update_jacobi_k<0>(n, k, alpha, X, r, p, q, dinv, P, P2, nt);
-    }
-}
-
+// dinv == nullptr: plain update; else the Jacobi-fused one (P2 receives r.(dinv r))
 void update(i64 n, int k, const double* alpha, double* X, double* r, const double* p, const double* q,
-            Partials& P, int nt) {
+            const double* dinv, Partials& P, Partials* P2, int nt) {
+    if (dinv) {
+        switch (k) {
+            case 1: update_k<1, true>(n, k, alpha, X, r, p, q, dinv, P, P2, nt); break;
+            case 3: update_k<3, true>(n, k, alpha, X, r, p, q, dinv, P, P2, nt); break;
+            case 6: update_k<6, true>(n, k, alpha, X, r, p, q, dinv, P, P2, nt); break;
+            default: update_k<0, true>(n, k, alpha, X, r, p, q, dinv, P, P2, nt);
+        }
+        return;
+    }
     switch (k) {
-        case 1: update_k<1>(n, k, alpha, X, r, p, q, P, nt); break;
-        case 3: update_k<3>(n, k, alpha, X, r, p, q, P, nt); break;
-        case 6: update_k<6>(n, k, alpha, X, r, p, q, P, nt); break;
-        default: update_k<0>(n, k, alpha, X, r, p, q, P, nt);
+        case 1: update_k<1, false>(n, k, alpha, X, r, p, q, nullptr, P, nullptr, nt); break;
+        case 3: update_k<3, false>(n, k, alpha, X, r, p, q, nullptr, P, nullptr, nt); break;
+        case 6: update_k<6, false>(n, k, alpha, X, r, p, q, nullptr, P, nullptr, nt); break;
+        default: update_k<0, false>(n, k, alpha, X, r, p, q, nullptr, P, nullptr, nt);
     }
 }
 }  // namespace
@@ -219,12 +197,8 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
             breakdown = breakdown || (active[j] && !(pq[j] > 0.0 && std::isfinite(alpha[j])));
         }
         if (breakdown) { res.status = 3; res.iterations = it; break; }
-        if (fused) {
-            update_jacobi(n, k, alpha.data(), X, r, p.data(), q.data(), dinv, P, P2, nt);
-            P2.reduce(rz_new);
-        } else {
-            update(n, k, alpha.data(), X, r, p.data(), q.data(), P, nt);
-        }
+        update(n, k, alpha.data(), X, r, p.data(), q.data(), fused ? dinv : nullptr, P, &P2, nt);
+        if (fused) P2.reduce(rz_new);
         P.reduce(rr);
         res.iterations = it;
         any = false;

@@ -27,20 +27,6 @@ inline void face_cross(const double* V, const i64* F, i64 f, double c[3]) {
     cross3(e1, e2, c);
 }
 
-// Tangent frame of recovery.recovery_operator: e1 = N x a / |N x a| (a = the first
-// coordinate axis least aligned with N), e2 = N x e1.
-inline void tangent_frame(const double* n, double e1[3], double e2[3]) {
-    int ax = 0;
-    double best = std::fabs(n[0]);
-    for (int a = 1; a < 3; ++a)
-        if (std::fabs(n[a]) < best) { best = std::fabs(n[a]); ax = a; }
-    double axis[3] = {0, 0, 0};
-    axis[ax] = 1.0;
-    cross3(n, axis, e1);
-    const double ne = std::sqrt(dot3(e1, e1));
-    for (int a = 0; a < 3; ++a) e1[a] /= ne;
-    cross3(n, e1, e2);
-}
 }  // namespace
 
 // recovery_weights: w[f] = |T| min(1, q~_T / floor), q_T = 4 sqrt(3) |T| / (l0^2 + l1^2 + l2^2)
@@ -188,22 +174,17 @@ void tangent_projection6(double* X, const double* N, const unsigned char* ref, i
 #endif
     for (i64 r = 0; r < n; ++r) {
         if (ref && !ref[r]) continue;
-        double S[3][3], P[3][3], T[3][3], U[3][3];
+        double S[3][3], U[3][3];
         for (int s = 0; s < 6; ++s) S[SYM[s][0]][SYM[s][1]] = S[SYM[s][1]][SYM[s][0]] = X[6 * r + s];
         const double* nv = N + 3 * r;
-        for (int p = 0; p < 3; ++p)
-            for (int q = 0; q < 3; ++q) P[p][q] = (p == q ? 1.0 : 0.0) - nv[p] * nv[q];
-        for (int p = 0; p < 3; ++p)
-            for (int q = 0; q < 3; ++q) T[p][q] = P[p][0] * S[0][q] + P[p][1] * S[1][q] + P[p][2] * S[2][q];
-        for (int p = 0; p < 3; ++p)
-            for (int q = 0; q < 3; ++q) U[p][q] = T[p][0] * P[0][q] + T[p][1] * P[1][q] + T[p][2] * P[2][q];
+        project_tangent(nv, S, U);
         double nsn = 0.0;
         if (keep_trace)
             for (int p = 0; p < 3; ++p)
                 for (int q = 0; q < 3; ++q) nsn += nv[p] * S[p][q] * nv[q];
         for (int s = 0; s < 6; ++s) {
             const int p = SYM[s][0], q = SYM[s][1];
-            X[6 * r + s] = 0.5 * (U[p][q] + U[q][p]) + 0.5 * nsn * P[p][q];
+            X[6 * r + s] = 0.5 * (U[p][q] + U[q][p]) + 0.5 * nsn * ((p == q ? 1.0 : 0.0) - nv[p] * nv[q]);
         }
     }
 }
