@@ -258,12 +258,12 @@ def solve_spd(A, R, *, method="auto", rtol=1e-10, maxiter=None, preconditioner=N
         over the k columns, preconditioned by ``preconditioner`` (a sparse SPD
         approximation of A⁻¹, e.g. :func:`face_schwarz_preconditioner`) or,
         without one, Jacobi.
-        "direct": sparse Cholesky (:func:`igl_hhj.solvers.cholesky_solve`:
-        CHOLMOD via cholespy, SuperLU if absent).
+        "direct": one sparse factorisation (:func:`igl_hhj.solvers.cholesky_solve`:
+        SuperLU-MMD up to 80k unknowns, CHOLMOD via cholespy above).
         "auto": direct up to ``AUTO_DIRECT_MAX`` (50 000) unknowns; above,
         PCG, switching to the direct solver as soon as the measured
         convergence rate predicts more than ``maxiter`` (default
-        ``AUTO_CG_MAXITER`` = 600) iterations (checked every 20 iterations).
+        ``AUTO_CG_MAXITER`` = 600) further iterations (checked every 20 iterations).
     rtol : float
         CG stops when ``‖r_j‖ ≤ rtol ‖R_j‖`` for every column j.  The default
         1e-10 leaves a solver error far below every discretisation error in
