@@ -561,8 +561,8 @@ def vertex_shape_operator(mesh, S, *, smoothing=0, recovery="patch"):
     N : (#V, 3) vertex normals used
     """
     _check_smoothing(smoothing, "smoothing")
-    length = _recovery.smoothing_length(mesh, smoothing) if smoothing > 0 else 0.0
     if recovery == "patch":       # compiled (reference: _vertex_shape_operator_numpy)
+        length = _recovery.smoothing_length(mesh, smoothing) if smoothing > 0 else 0.0
         return _recovery.recover_and_smooth(mesh, S, length)
     return _vertex_shape_operator_numpy(mesh, S, smoothing=smoothing, recovery=recovery)
 

@@ -440,8 +440,7 @@ class TriangleMesh:
         cross, dbl, l2max = kernels.face_metrics(self.V, self.F)
         self.__dict__["_cross"] = cross
         self.__dict__["face_double_areas"] = dbl
-        with np.errstate(over="ignore", invalid="ignore"):
-            bad = _zero_area(dbl, l2max)
+        bad = _zero_area(dbl, l2max)
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
             n = int(bad.sum())

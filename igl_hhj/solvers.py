@@ -124,10 +124,10 @@ def _cholmod(A):
     return solve
 
 
-def factorize(A, *, prefer_lu=False, small_max=LU_MMD_MAX):
+def factorize(A, *, prefer_lu=False):
     """One sparse factorisation of a symmetric positive (semi-)definite A: a ``solve(R)`` callable.
 
-    Up to ``small_max`` unknowns SuperLU without pivoting (:data:`LU_MMD_MAX`), above
+    Up to :data:`LU_MMD_MAX` unknowns SuperLU without pivoting, above
     CHOLMOD; LU with partial pivoting when ``prefer_lu`` is set (matrices known to be
     numerically semi-definite, e.g. with faces of relative area ~1e-9) or when the
     first choice fails.  ``R`` (n, k) C-contiguous float64."""
@@ -137,13 +137,13 @@ def factorize(A, *, prefer_lu=False, small_max=LU_MMD_MAX):
         A.sum_duplicates()
     if not prefer_lu:
         fn = None
-        if A.shape[0] <= small_max:
+        if A.shape[0] > LU_MMD_MAX:
+            fn = _cholmod(A)
+        else:
             try:
                 fn = _splu(A, pivot=False)
             except SolverError:
-                fn = None
-        else:
-            fn = _cholmod(A)
+                pass
         if fn is not None:
             return fn
     return _splu(A, pivot=True)
