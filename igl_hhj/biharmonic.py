@@ -55,18 +55,22 @@ The matrices are factorised once per (mesh, bc, mass) in
 :class:`BiharmonicSolver`; :func:`biharmonic_solve` is the one-shot wrapper.
 Nothing ever forms a dense ``M⁻¹``:
 
+SPD matrices are factorised by SuperLU in symmetric mode (minimum-degree ordering)
+up to :data:`igl_hhj.solvers.LU_MMD_MAX` unknowns and by CHOLMOD (cholespy) above.
+
 * clamped, lumped mass: the Schur complement ``K_IA M⁻¹ K_AI`` is sparse (two-ring
-  stencil) and SPD; one sparse LU (symmetric mode, minimum-degree ordering).
+  stencil) and SPD; one sparse factorisation.
 * clamped, full mass: ``solver="saddle"`` factorises the indefinite system (6.1)
   with SuperLU (COLAMD, partial pivoting); ``solver="schur"`` runs conjugate
-  gradients on the Schur complement ``K_IA M⁻¹ K_AI`` (``M⁻¹`` applied through a
-  sparse factorisation of ``M``) preconditioned by the factorised lumped Schur
-  complement; since ``M_L/4 ≤ M ≤ M_L`` for P1 triangles the preconditioned
-  spectrum lies in [1, 4] and CG needs ~15–25 iterations at any ``h``.
-  ``"auto"`` picks ``"saddle"`` up to 250 000 vertices and ``"schur"`` above
-  (less memory; the saddle LU is faster for repeated solves).
-* navier / closed: one sparse LU of ``K_II`` (closed: one pinned vertex per
-  component), used for both Poisson solves.
+  gradients on the Schur complement ``K_IA M⁻¹ K_AI`` preconditioned by the
+  factorised lumped Schur complement; since ``M_L/4 ≤ M ≤ M_L`` for P1 triangles the
+  preconditioned spectrum lies in [1, 4] and CG needs ~15–25 iterations at any ``h``.
+  ``M⁻¹`` is applied by the compiled PCG preconditioned with the lumped mass
+  (:func:`igl_hhj.solvers.mass_solver`, spectrum in [1/4, 1]; no factorisation of M).
+  ``"auto"`` picks ``"saddle"`` up to :data:`AUTO_SADDLE_MAX_VERTICES` vertices and
+  ``"schur"`` above (faster and less memory; the saddle LU is faster for repeated solves).
+* navier / closed: one sparse factorisation of ``K_II`` (closed: one pinned vertex
+  per component), used for both Poisson solves.
 """
 from __future__ import annotations
 
@@ -76,6 +80,7 @@ import scipy.sparse.linalg as spla
 
 from .hhj import SolverDidNotConverge
 from .mesh import as_mesh
+from .solvers import LU_MMD_MAX, _cholmod, mass_solver
 
 __all__ = ["BiharmonicSolver", "biharmonic_solve", "stiffness_matrix", "mass_matrix",
            "boundary_mass_matrix"]
@@ -85,11 +90,12 @@ MASS_TYPES = ("full", "lumped", "voronoi")
 SOLVERS = ("auto", "saddle", "schur")
 
 # "auto" switches the clamped full-mass solve from the saddle-point LU to
-# Schur-complement PCG above this many vertices.  Measured on a clamped
-# hemisphere (2 shared cores): 151k vertices, saddle 6.7 s setup + 0.1 s solve,
-# PCG 4.8 s + 2.1 s; 603k vertices, saddle 68 s + 0.5 s at 7.1 GB peak memory,
-# PCG 58 s + 22 s at 5.4 GB.  The saddle LU is kept while its memory is modest.
-AUTO_SADDLE_MAX_VERTICES = 250_000
+# Schur-complement PCG above this many vertices, where the lumped Schur complement
+# is factorised by CHOLMOD (LU_MMD_MAX) and M⁻¹ is the compiled PCG.  Measured on the
+# clamped hemisphere (2 shared cores, setup + one solve): 38k vertices saddle 1.25 s,
+# Schur 1.46 s; 151k saddle 11.0 s, Schur 7.2 s; 603k Schur 55 s (one CHOLMOD
+# factorisation of the lumped K M⁻¹ K alone: 43 s).
+AUTO_SADDLE_MAX_VERTICES = 80_000
 
 # Relative tolerance of the zero-mean check of f for bc="closed":
 # |∫ I_h f| <= ZERO_MEAN_RTOL * ∫ |I_h f| on every connected component.
@@ -163,20 +169,29 @@ def boundary_mass_matrix(mesh):
 
 # ---------------------------------------------------------------- factorisations
 def _factorize_spd(A):
-    """Sparse LU of an SPD matrix in symmetric mode (no pivoting) and the
-    ``solve`` callable.
+    """One sparse factorisation of an SPD matrix and its ``solve`` callable.
 
-    The matrix is first permuted by reverse Cuthill–McKee, then SuperLU orders
-    it by minimum degree on ``Aᵀ + A``: on refined meshes this is ~100× faster
-    than minimum degree on the raw vertex order (whose ordering step alone took
-    25 s for a 41k-vertex sphere) and has ~2× less fill than COLAMD.
+    Above :data:`igl_hhj.solvers.LU_MMD_MAX` unknowns CHOLMOD's supernodal Cholesky
+    (cholespy, :func:`igl_hhj.solvers.factorize`'s large-matrix choice: 4-6x faster than
+    SuperLU on the 151k-603k-vertex hemispheres of
+    ``biharmonic_convergence --perf``).  Below, and when CHOLMOD finds the matrix not
+    numerically positive definite, SuperLU in symmetric mode (no pivoting): the matrix
+    is first permuted by reverse Cuthill–McKee, then SuperLU orders it by minimum
+    degree on ``Aᵀ + A``; on refined meshes this is ~100× faster than minimum degree
+    on the raw vertex order (whose ordering step alone took 25 s for a 41k-vertex
+    sphere) and has ~2× less fill than COLAMD.
     """
     from scipy.sparse.csgraph import reverse_cuthill_mckee
     A = sp.csr_matrix(A)
     if A.shape[0] == 0:
         return lambda b: np.zeros_like(b)
-    p = reverse_cuthill_mckee(A, symmetric_mode=True)
     _check_finite_matrix(A)
+    if A.shape[0] > LU_MMD_MAX:
+        A.sum_duplicates()
+        chol = _cholmod(A)
+        if chol is not None:
+            return chol
+    p = reverse_cuthill_mckee(A, symmetric_mode=True)
     try:
         lu = spla.splu(sp.csc_matrix(A[p][:, p]), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                        options={"SymmetricMode": True})
@@ -405,10 +420,9 @@ class BiharmonicSolver:
                 S = sp.bmat([[None, self._Bmat], [self._Bmat.T, -M_AA]], format="csc")
                 self._solve_saddle = _factorize_general(S)
             else:
-                self._M_AA = M_AA
-                self._solve_M = _factorize_spd(M_AA)
                 ml = np.asarray(M_AA.sum(axis=1)).ravel()   # barycentric lumping
                 self._minv = 1.0 / ml
+                self._solve_M = mass_solver(M_AA, self._minv, max(1e-3 * self.rtol, 1e-14))
                 Q = self._Bmat @ sp.diags(self._minv) @ self._Bmat.T
                 self._solve_Q = _factorize_spd(Q)
 

@@ -44,7 +44,7 @@ except ImportError:  # pragma: no cover - cholespy is a dependency
 from . import kernels
 from .errors import SolverDidNotConverge, SolverError
 
-__all__ = ["DEFAULT_RTOL", "HHJSystem", "cholesky_solve", "pcg", "SolveInfo"]
+__all__ = ["DEFAULT_RTOL", "HHJSystem", "cholesky_solve", "mass_solver", "pcg", "SolveInfo"]
 
 DEFAULT_RTOL = 1e-6
 # "auto": factorise without trying PCG up to this many unknowns (everything is instant there)
@@ -164,6 +164,43 @@ def cholesky_solve(A, R, *, prefer_lu=False):
     if not np.isfinite(X).all():
         raise SolverError("the sparse direct solve produced non-finite values (matrix numerically singular)")
     return X
+
+
+def mass_solver(M, lumped_inv, rtol=1e-13):
+    """``solve(b) = M⁻¹ b`` (b of shape (n,) or (n, k)) for a consistent P1 mass matrix,
+    by the compiled PCG preconditioned with the lumped mass.
+
+    On every P1 triangle the element mass ``|T|/12 (1 + δ_ij)`` has eigenvalues
+    ``{1, 1/4, 1/4}`` times the lumped one ``|T|/3``, so the spectrum of ``M_L⁻¹ M`` lies
+    in [1/4, 1] whatever the mesh quality: CG gains a factor ≥ 3 per iteration (≈ 27
+    iterations for 1e-13).  No factorisation, no fill: 0.1 s per solve at 603k vertices.
+    If the PCG stalls (zero-area faces: zero lumped mass) the matrix is factorised
+    instead (:func:`factorize`).
+
+    Parameters
+    ----------
+    M : (n, n) sparse SPD, the consistent mass
+    lumped_inv : (n,) float64, ``1 / rowsum(M)``
+    rtol : float, relative residual per column
+    """
+    M = sp.csr_matrix(M)
+    if not M.has_canonical_format:
+        M = M.copy()
+        M.sum_duplicates()
+    fallback = []
+
+    def solve(b):
+        b = np.asarray(b, dtype=np.float64)
+        if fallback:
+            return fallback[0](np.ascontiguousarray(b))
+        X, _, status, _ = pcg(M.indptr, M.indices, M.data, b.reshape(len(b), -1),
+                              rtol=rtol, maxiter=500, dinv=lumped_inv)
+        if status != 0 or not np.isfinite(X).all():
+            fallback.append(factorize(M))
+            return fallback[0](np.ascontiguousarray(b))
+        return X.reshape(b.shape)
+
+    return solve
 
 
 def pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None, probe_iter=0,
