@@ -56,7 +56,7 @@ The matrices are factorised once per (mesh, bc, mass) in
 Nothing ever forms a dense ``M⁻¹``:
 
 SPD matrices are factorised by SuperLU in symmetric mode (minimum-degree ordering)
-up to :data:`igl_hhj.solvers.LU_MMD_MAX` unknowns and by CHOLMOD (cholespy) above.
+up to :data:`CHOLMOD_MIN_UNKNOWNS` unknowns and by CHOLMOD (cholespy) above.
 
 * clamped, lumped mass: the Schur complement ``K_IA M⁻¹ K_AI`` is sparse (two-ring
   stencil) and SPD; one sparse factorisation.
@@ -80,7 +80,7 @@ import scipy.sparse.linalg as spla
 
 from .hhj import SolverDidNotConverge
 from .mesh import as_mesh
-from .solvers import LU_MMD_MAX, _cholmod, mass_solver
+from .solvers import _cholmod, mass_solver
 
 __all__ = ["BiharmonicSolver", "biharmonic_solve", "stiffness_matrix", "mass_matrix",
            "boundary_mass_matrix"]
@@ -91,11 +91,16 @@ SOLVERS = ("auto", "saddle", "schur")
 
 # "auto" switches the clamped full-mass solve from the saddle-point LU to
 # Schur-complement PCG above this many vertices, where the lumped Schur complement
-# is factorised by CHOLMOD (LU_MMD_MAX) and M⁻¹ is the compiled PCG.  Measured on the
+# is factorised by CHOLMOD (CHOLMOD_MIN_UNKNOWNS) and M⁻¹ is the compiled PCG.  Measured on the
 # clamped hemisphere (2 shared cores, setup + one solve): 38k vertices saddle 1.25 s,
 # Schur 1.46 s; 151k saddle 11.0 s, Schur 7.2 s; 603k Schur 55 s (one CHOLMOD
 # factorisation of the lumped K M⁻¹ K alone: 43 s).
 AUTO_SADDLE_MAX_VERTICES = 80_000
+
+# SPD factorisations above this many unknowns use CHOLMOD (cholespy), below SuperLU
+# (symmetric mode, RCM + minimum degree): CHOLMOD factorises the lumped K M⁻¹ K of the
+# 151k-vertex hemisphere in 5.0 s, SuperLU in 6.6 s; below ~40k they are even.
+CHOLMOD_MIN_UNKNOWNS = 80_000
 
 # Relative tolerance of the zero-mean check of f for bc="closed":
 # |∫ I_h f| <= ZERO_MEAN_RTOL * ∫ |I_h f| on every connected component.
@@ -171,10 +176,8 @@ def boundary_mass_matrix(mesh):
 def _factorize_spd(A):
     """One sparse factorisation of an SPD matrix and its ``solve`` callable.
 
-    Above :data:`igl_hhj.solvers.LU_MMD_MAX` unknowns CHOLMOD's supernodal Cholesky
-    (cholespy, :func:`igl_hhj.solvers.factorize`'s large-matrix choice: 4-6x faster than
-    SuperLU on the 151k-603k-vertex hemispheres of
-    ``biharmonic_convergence --perf``).  Below, and when CHOLMOD finds the matrix not
+    Above :data:`CHOLMOD_MIN_UNKNOWNS` unknowns CHOLMOD's supernodal Cholesky
+    (cholespy).  Below, and when CHOLMOD finds the matrix not
     numerically positive definite, SuperLU in symmetric mode (no pivoting): the matrix
     is first permuted by reverse Cuthill–McKee, then SuperLU orders it by minimum
     degree on ``Aᵀ + A``; on refined meshes this is ~100× faster than minimum degree
@@ -186,7 +189,7 @@ def _factorize_spd(A):
     if A.shape[0] == 0:
         return lambda b: np.zeros_like(b)
     _check_finite_matrix(A)
-    if A.shape[0] > LU_MMD_MAX:
+    if A.shape[0] > CHOLMOD_MIN_UNKNOWNS:
         A.sum_duplicates()
         chol = _cholmod(A)
         if chol is not None:

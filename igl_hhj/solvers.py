@@ -3,8 +3,7 @@
 Three ways to solve, chosen per call:
 
 * ``"direct"``: one sparse factorisation for all right-hand sides (:func:`factorize`):
-  SuperLU in symmetric mode with a minimum-degree ordering up to :data:`LU_MMD_MAX`
-  unknowns, CHOLMOD (``cholespy``) above.
+  QDLDL (AMD ordering, LDLᵀ) up to :data:`LDL_MAX` unknowns, CHOLMOD (``cholespy``) above.
 * ``"cg"``: the compiled fused block PCG (:func:`igl_hhj.kernels.block_pcg`),
   preconditioned by a two-level method: the face-Schwarz preconditioner (exact
   inverses of every face's 3×3 block of A) plus an exact sparse Cholesky solve on
@@ -40,6 +39,10 @@ try:  # imported here, not in the first solve (first call ≈ later calls, issue
     from cholespy import CholeskySolverD, MatrixType
 except ImportError:  # pragma: no cover - cholespy is a dependency
     CholeskySolverD = MatrixType = None
+try:
+    import qdldl as _qdldl
+except ImportError:  # pragma: no cover - qdldl is a dependency
+    _qdldl = None
 
 from . import kernels
 from .errors import SolverDidNotConverge, SolverError
@@ -60,8 +63,10 @@ CG_MAXITER = 5000
 # `python -m igl_hhj.benchmarks.speed --sliver-study` (0°-25° on camelhead, the bunny
 # upsampled twice, an open scan and a jittered ellipsoid: 15-20° is fastest on all four)
 SLIVER_ANGLE = 20.0
-# above this fraction of sliver DOFs the mesh is "all slivers": "auto" factorises A itself
-SLIVER_MAX_FRACTION = 0.8
+# above this fraction of sliver DOFs "auto" factorises A itself: the two-level's subdomain
+# factorisation then costs a good part of the full one, with the PCG on top (open scan,
+# 52 % sliver DOFs: direct 137 ms, two-level PCG 171 ms; camelhead, 26 %: 74 / 70 ms)
+SLIVER_MAX_FRACTION = 0.4
 
 
 class SolveInfo(dict):
@@ -70,11 +75,12 @@ class SolveInfo(dict):
 
 def _direct_seconds(n):
     """Estimated time of one sparse factorisation + solve of the HHJ matrix (n unknowns) by
-    :func:`factorize`: power-law fits on this machine (``python -m igl_hhj.benchmarks.speed``,
-    "S_h direct"): SuperLU-MMD up to :data:`LU_MMD_MAX` (≈ 0.1 s at 34k unknowns, camelhead;
-    0.14 s at 58k, the open scan), CHOLMOD above (≈ 0.8 s at 123k, 2.9 s at 393k)."""
-    if n <= LU_MMD_MAX:
-        return 1.1e-7 * n ** 1.3
+    :func:`factorize`: power-law fits to ``python -m igl_hhj.benchmarks.speed --factor-study``
+    on this machine.  QDLDL up to :data:`LDL_MAX`: 12 ms at 10k unknowns (bunny), 50 ms at
+    34k (camelhead), 88 ms at 58k (the open scan), 0.46 s at 167k (bunny upsampled twice),
+    0.55 s at 123k (the jittered ellipsoid, more fill); CHOLMOD above: 2.9 s at 393k."""
+    if n <= LDL_MAX:
+        return 5.0e-8 * n ** 1.33
     return 3.9e-7 * n ** 1.255
 
 
@@ -86,24 +92,49 @@ def _pcg_iter_seconds(n, k):
     return 0.6e-8 * n * (1 + k)
 
 
-# Below this many unknowns the direct solver is SuperLU in symmetric mode with a minimum-degree
-# ordering of A + Aᵀ (no pivoting: A is SPD); above, CHOLMOD's supernodal Cholesky.  Measured on
-# the HHJ matrices of the shared meshes (``--sliver-study`` meshes): SuperLU-MMD factorises
-# 10k–58k unknowns 1.6–1.9x faster than cholespy, and is 1.6x slower at 167k.
-LU_MMD_MAX = 80_000
+# Up to this many unknowns the direct solver is QDLDL (AMD ordering + simplicial LDLᵀ, the
+# ``qdldl`` wheel); above, CHOLMOD's supernodal Cholesky (cholespy, whose bundled reference
+# BLAS makes its supernodal kernels slow on small and medium matrices).  Measured on the
+# HHJ matrices (python -m igl_hhj.benchmarks.speed --factor-study): QDLDL factorises 10k–167k
+# unknowns 1.6–3.4x faster than CHOLMOD and 1.6–4x faster than SuperLU-MMD; CHOLMOD wins
+# at 393k (2.8 s against 4.0 s).  QDLDL's solves are 2–3x slower than CHOLMOD's.
+LDL_MAX = 200_000
 
 
-def _splu(A, pivot):
-    """SuperLU: ``pivot`` False, symmetric mode (no pivoting, for SPD A) with the minimum-degree
-    ordering of A + Aᵀ; ``pivot`` True, partial pivoting with SuperLU's default COLAMD ordering
-    (with pivoting the symmetric ordering loses its sparsity: 30 s instead of 0.25 s on the
-    open scan)."""
-    opts = {"permc_spec": "MMD_AT_PLUS_A", "diag_pivot_thresh": 0.0,
-            "options": {"SymmetricMode": True}} if not pivot else {}
+def _splu(A):
+    """SuperLU with partial pivoting and its default COLAMD ordering (the fallback for
+    numerically semi-definite matrices; the symmetric minimum-degree ordering loses its
+    sparsity under pivoting: 30 s instead of 0.25 s on the open scan)."""
     try:
-        return spla.splu(sp.csc_matrix(A), **opts).solve
+        return spla.splu(sp.csc_matrix(A)).solve
     except RuntimeError as exc:
         raise SolverError(f"sparse LU failed: {exc}") from None
+
+
+def _ldl(A):
+    """QDLDL factorisation (AMD + LDLᵀ, no pivoting) of symmetric CSR A: a ``solve(R, out=None)``
+    callable, or None when qdldl is missing or meets a zero pivot."""
+    if _qdldl is None:  # pragma: no cover
+        return None
+    # CSR of a symmetric matrix read as CSC is the same matrix: no conversion
+    try:
+        f = _qdldl.Solver(sp.csc_matrix((A.data, A.indices, A.indptr), shape=A.shape))
+    except (ValueError, RuntimeError):
+        return None
+
+    def solve(R, out=None):
+        R = np.asarray(R, dtype=np.float64)
+        if R.ndim == 1:
+            X = f.solve(R)
+            if out is None:
+                return X
+            out[...] = X
+            return out
+        X = np.empty_like(R) if out is None else out
+        for j in range(R.shape[1]):
+            X[:, j] = f.solve(np.ascontiguousarray(R[:, j]))
+        return X
+    return solve
 
 
 def _cholmod(A):
@@ -127,39 +158,47 @@ def _cholmod(A):
 def factorize(A, *, prefer_lu=False):
     """One sparse factorisation of a symmetric positive (semi-)definite A: a ``solve(R)`` callable.
 
-    Up to :data:`LU_MMD_MAX` unknowns SuperLU without pivoting, above
-    CHOLMOD; LU with partial pivoting when ``prefer_lu`` is set (matrices known to be
-    numerically semi-definite, e.g. with faces of relative area ~1e-9) or when the
-    first choice fails.  ``R`` (n, k) C-contiguous float64."""
+    Up to :data:`LDL_MAX` unknowns QDLDL, above CHOLMOD; LU with partial pivoting
+    (SuperLU) when ``prefer_lu`` is set (matrices known to be numerically semi-definite,
+    e.g. with faces of relative area ~1e-9) or when the first choice fails.
+    ``R`` (n,) or (n, k) float64."""
     A = sp.csr_matrix(A)
     if not A.has_canonical_format:
         A = A.copy()          # sum_duplicates works in place: leave the caller's matrix alone
         A.sum_duplicates()
     if not prefer_lu:
-        fn = None
-        if A.shape[0] > LU_MMD_MAX:
-            fn = _cholmod(A)
-        else:
-            try:
-                fn = _splu(A, pivot=False)
-            except SolverError:
-                pass
+        fn = _ldl(A) if A.shape[0] <= LDL_MAX else _cholmod(A)
         if fn is not None:
             return fn
-    return _splu(A, pivot=True)
+    return _splu(A)
 
 
-def cholesky_solve(A, R, *, prefer_lu=False):
+# A direct solve without pivoting is accepted when ‖A X - R‖ ≤ this × ‖R‖ per column;
+# otherwise (tiny pivots of a numerically semi-definite A) pivoted LU solves again.
+DIRECT_RESIDUAL_RTOL = 1e-8
+
+
+def cholesky_solve(A, R):
     """Solve ``A X = R`` for SPD sparse A by one sparse factorisation (:func:`factorize`).
 
-    ``R`` (n,) or (n, k).  Raises :class:`SolverError` when the factorisation fails or
-    the solution is not finite (after retrying with pivoted LU)."""
+    ``R`` (n,) or (n, k).  The unpivoted factorisation is tried first even where A is
+    numerically semi-definite (the open scan's one face with a singular 3×3 block:
+    pivoted SuperLU took 3x longer than QDLDL); its solution is kept when its relative
+    residual is at most :data:`DIRECT_RESIDUAL_RTOL` (one extra product with A), else
+    pivoted LU solves again.  Raises :class:`SolverError` when the factorisation
+    fails or the solution is not finite."""
     R = np.ascontiguousarray(R, dtype=np.float64)
     n = A.shape[0]
     if n == 0:
         return np.zeros_like(R)
-    X = factorize(A, prefer_lu=prefer_lu)(R)
-    if not np.isfinite(X).all() and not prefer_lu:
+    A = sp.csr_matrix(A)
+    if not A.has_canonical_format:
+        A = A.copy()
+        A.sum_duplicates()
+    X = factorize(A)(R)
+    R2 = R.reshape(n, -1)
+    res = np.linalg.norm((A @ X.reshape(n, -1)) - R2, axis=0)
+    if not (np.isfinite(X).all() and np.all(res <= DIRECT_RESIDUAL_RTOL * np.linalg.norm(R2, axis=0))):
         X = factorize(A, prefer_lu=True)(R)
     if not np.isfinite(X).all():
         raise SolverError("the sparse direct solve produced non-finite values (matrix numerically singular)")
@@ -297,13 +336,14 @@ class HHJSystem:
         when A_SS cannot be factorised (numerically singular faces: face-Schwarz alone)."""
         A = self.csr()[S][:, S].tocsr()
         A.sum_duplicates()
-        # CHOLMOD: its solves are ~3x faster than SuperLU's, and the two-level applies
-        # one per PCG iteration; pivoted LU where A_SS is numerically semi-definite
-        chol = _cholmod(A)
+        # QDLDL (CHOLMOD above LDL_MAX): on the sliver subdomains of the --sliver-study meshes
+        # its factorisation + one solve per PCG iteration beat CHOLMOD (open scan 64 ms
+        # against 101 ms) and SuperLU; pivoted LU where A_SS is numerically semi-definite
+        chol = _ldl(A) if A.shape[0] <= LDL_MAX else _cholmod(A)
         if chol is not None:
             return lambda r, z: chol(r, out=z)
         try:
-            lu = _splu(A, pivot=True)
+            lu = _splu(A)
         except SolverError:
             return None
 
@@ -328,7 +368,7 @@ class HHJSystem:
         out[self.perm] = np.einsum("es,esk->ek", self.A_full, v[self.cols])
         return out
 
-    def _pcg(self, rhs, solver, rtol, S, prefer_lu, info):
+    def _pcg(self, rhs, solver, rtol, S, info):
         n, k = rhs.shape
         M = (self.indptr, self._cols_flat, self.M.ravel())
         sub = {}
@@ -368,7 +408,7 @@ class HHJSystem:
                 # rhs now holds the final residual r = rhs - A X: rebuild rhs = r + A X
                 # (rounding ≤ eps ‖A X‖, and ‖A X‖ ≤ 1e4 ‖rhs‖ by the breakdown test)
                 rhs += np.einsum("es,esk->ek", self.A, X[self.cols])
-            X = cholesky_solve(self.csr(), rhs, prefer_lu=prefer_lu)
+            X = cholesky_solve(self.csr(), rhs)
             info.update(switched=True, solver="direct")
         return X, info
 
@@ -395,20 +435,17 @@ class HHJSystem:
         info = SolveInfo(solver=solver, iterations=0, switched=False)
         if solver == "auto" and n <= AUTO_DIRECT_MAX:
             solver = "direct"
-        # faces whose 3x3 block is numerically singular make A numerically semi-definite:
-        # LU with pivoting instead of Cholesky there
-        prefer_lu = self.n_jacobi_faces > 0
         if solver == "direct":
-            X = cholesky_solve(self.csr(), rhs, prefer_lu=prefer_lu)
+            X = cholesky_solve(self.csr(), rhs)
             info["solver"] = "direct"
         else:
             S = self.sliver_dofs()
             info["sliver_dofs"] = len(S)
             if solver == "auto" and len(S) > SLIVER_MAX_FRACTION * n and n <= DIRECT_MAX:
-                X = cholesky_solve(self.csr(), rhs, prefer_lu=prefer_lu)
+                X = cholesky_solve(self.csr(), rhs)
                 info["solver"] = "direct"
             else:
-                X, info = self._pcg(rhs, solver, rtol, S, prefer_lu, info)
+                X, info = self._pcg(rhs, solver, rtol, S, info)
         if not np.isfinite(X).all():
             raise SolverError("the HHJ solve produced non-finite values")
         out = np.empty_like(X)

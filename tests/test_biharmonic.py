@@ -221,7 +221,7 @@ def test_saddle_and_schur_solvers_agree():
 
 @pytest.mark.parametrize("mass", ["full", "lumped"])
 def test_cholmod_path_equals_superlu_path(mass, monkeypatch):
-    """Above ``LU_MMD_MAX`` unknowns the SPD factorisations are CHOLMOD's; forcing that
+    """Above ``CHOLMOD_MIN_UNKNOWNS`` unknowns the SPD factorisations are CHOLMOD's; forcing that
     branch on a small mesh gives the SuperLU solution (clamped Schur + lumped, navier)."""
     import igl_hhj.biharmonic as bh
     P = Hemisphere()
@@ -233,7 +233,7 @@ def test_cholmod_path_equals_superlu_path(mass, monkeypatch):
            BiharmonicSolver(V, F, bc="navier", mass=mass).solve(P.f, g=g)]
     calls = []
     real = bh._cholmod
-    monkeypatch.setattr(bh, "LU_MMD_MAX", 0)
+    monkeypatch.setattr(bh, "CHOLMOD_MIN_UNKNOWNS", 0)
     monkeypatch.setattr(bh, "_cholmod", lambda A: calls.append(A.shape[0]) or real(A))
     new = [BiharmonicSolver(V, F, mass=mass, solver="schur" if mass == "full" else "auto",
                             rtol=1e-12).solve(P.f, g=g),

@@ -395,3 +395,44 @@ def test_mass_solver_equals_direct_solve_and_falls_back(closed, monkeypatch):
     monkeypatch.setattr(solvers, "pcg", lambda *a, **k: (np.zeros((M.shape[0], 1)), 500, 1, [1.0]))
     stalled = solvers.mass_solver(M, minv)
     assert rel(stalled(B[:, 0]), ref[:, 0]) <= RTOL
+
+
+def test_direct_solvers_agree_qdldl_cholmod_superlu(closed, monkeypatch):
+    """``factorize``: QDLDL up to ``LDL_MAX`` unknowns, CHOLMOD above, pivoted SuperLU as the
+    fallback; the three give the same solution of the HHJ system (1 and 3 columns)."""
+    from igl_hhj import solvers
+    A = HHJSystem(closed).csr()
+    R = np.random.default_rng(2).normal(size=(A.shape[0], 3))
+    used = []
+    for name in ("_ldl", "_cholmod", "_splu"):
+        real = getattr(solvers, name)
+        monkeypatch.setattr(solvers, name, lambda M, _r=real, _n=name: used.append(_n) or _r(M))
+    X = solvers.factorize(A)(R)
+    x1 = solvers.factorize(A)(R[:, 0])
+    monkeypatch.setattr(solvers, "LDL_MAX", 0)
+    Xc = solvers.factorize(A)(R)
+    Xl = solvers.factorize(A, prefer_lu=True)(R)
+    assert used == ["_ldl", "_ldl", "_cholmod", "_splu"]
+    assert rel(A @ X, R) <= 1e-12 and x1.shape == (A.shape[0],) and rel(x1, X[:, 0]) <= 1e-12
+    assert rel(Xc, X) <= RTOL and rel(Xl, X) <= RTOL
+
+
+def test_direct_solve_checks_its_residual_and_falls_back_to_pivoted_lu(closed, monkeypatch):
+    """An unpivoted factorisation whose solution does not satisfy A X = R to
+    ``DIRECT_RESIDUAL_RTOL`` (tiny pivots of a numerically semi-definite A) is replaced by
+    pivoted LU; a zero pivot (qdldl refuses) goes to pivoted LU as well."""
+    from igl_hhj import solvers
+    A = HHJSystem(closed).csr()
+    R = np.random.default_rng(3).normal(size=(A.shape[0], 2))
+    good = solvers.cholesky_solve(A, R)
+    calls = []
+    real_lu = solvers._splu
+    monkeypatch.setattr(solvers, "_splu", lambda M: calls.append(1) or real_lu(M))
+    monkeypatch.setattr(solvers, "_ldl", lambda M: (lambda B, out=None: 1.001 * solvers._cholmod(M)(B)))
+    X = solvers.cholesky_solve(A, R)
+    assert calls == [1] and rel(X, good) <= RTOL
+    Z = sp.csr_matrix(np.diag([1.0, 0.0, 2.0]))             # singular: qdldl's zero pivot
+    monkeypatch.undo()
+    assert solvers._ldl(Z) is None
+    with pytest.raises(SolverError):
+        solvers.cholesky_solve(Z, np.ones(3))

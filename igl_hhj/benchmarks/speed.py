@@ -2,7 +2,7 @@
 measured in the same run.
 
     python -m igl_hhj.benchmarks.speed [--quick] [--repeat 3] [--meshes DIR] [--out DIR]
-    python -m igl_hhj.benchmarks.speed --rtol-study | --sliver-study | --profile 'icosphere(8)'
+    python -m igl_hhj.benchmarks.speed --rtol-study | --sliver-study | --factor-study | --profile 'icosphere(8)'
 
 Meshes: icosphere(7) (328k faces) and icosphere(8) (1.31M), a jittered ellipsoid at
 82k / 328k / 1.31M faces (linear-scaling check), Walker's torus from a perturbed grid
@@ -299,6 +299,51 @@ def sliver_study(angles=SLIVER_ANGLES, mesh_dir=None, rtol=1e-8):
     return rows
 
 
+FACTOR_MESHES = ("real", "open scan 51k", "ellipsoid 82k", "bunny upsampled ×2", "torus 262k")
+
+
+def factor_study(names=FACTOR_MESHES, mesh_dir=None, repeat=2, k=3):
+    """Factorisation and k-column solve times (s) of the HHJ matrix A and of its sliver
+    block A_SS (the two-level's subdomain) with each direct solver :mod:`igl_hhj.solvers`
+    can use: QDLDL (AMD + LDLᵀ), CHOLMOD (cholespy) and SuperLU (symmetric mode,
+    minimum degree), in the same run; picks :data:`igl_hhj.solvers.LDL_MAX`."""
+    import scipy.sparse.linalg as spla
+
+    from igl_hhj import solvers
+    from igl_hhj.mesh import TriangleMesh
+    mesh_dir = _default_mesh_dir() if mesh_dir is None else Path(mesh_dir)
+
+    def superlu(A):
+        lu = spla.splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                       options={"SymmetricMode": True})
+        return lu.solve
+    makers = {"qdldl": solvers._ldl, "cholmod": solvers._cholmod, "superlu": superlu}
+    rows = []
+    for name in names:
+        for label, V, F in _build(name, mesh_dir):
+            system = solvers.HHJSystem(TriangleMesh(V, F))
+            A = system.csr()
+            S = system.sliver_dofs()
+            for part, M in (("A", A), ("A_SS", A[S][:, S].tocsr())):
+                R = np.random.default_rng(0).normal(size=(M.shape[0], k))
+                row = {"mesh": label, "part": part, "n": M.shape[0]}
+                for key, make in makers.items():
+                    t_f, solve = _best(lambda: make(M), repeat)
+                    t_s, _ = _best(lambda: solve(R), repeat)
+                    row[key] = (t_f, t_s)
+                rows.append(row)
+    return rows
+
+
+def factor_markdown(rows):
+    lines = ["| mesh | matrix | unknowns | QDLDL factor + solve (ms) | CHOLMOD | SuperLU-MMD |",
+             "|---|---|---|---|---|---|"]
+    for r in rows:
+        cells = [f"{1e3 * r[k][0]:.1f} + {1e3 * r[k][1]:.2f}" for k in ("qdldl", "cholmod", "superlu")]
+        lines.append(f"| {r['mesh']} | {r['part']} | {r['n']:,} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 def profile_stages(V, F, rtol=None):
     """CPU seconds (single thread) of the drop-in's stages on one mesh."""
     from igl_hhj import kernels, solvers
@@ -355,6 +400,8 @@ def main(argv=None):
                    help="folder for speed.md (default ./benchmark-results/)")
     p.add_argument("--sliver-study", action="store_true",
                    help="only PCG iterations / CPU time against the sliver threshold")
+    p.add_argument("--factor-study", action="store_true",
+                   help="only factorisation / solve times of the HHJ matrix: QDLDL, CHOLMOD, SuperLU")
     p.add_argument("--profile", default=None, metavar="MESH",
                    help="only the CPU time of each stage on one mesh, e.g. 'icosphere(8)'")
     p.add_argument("--rtol-study", action="store_true",
@@ -366,6 +413,9 @@ def main(argv=None):
         lines += [f"| {r['mesh']} | {r['faces']:,} | {r['angle']}° | {100 * r['fraction']:.0f} % | "
                   f"{r['iterations']} | {r['seconds']:.3f} |" for r in rows]
         print("\n".join(lines))
+        return
+    if a.factor_study:
+        print(factor_markdown(factor_study(mesh_dir=a.meshes, repeat=a.repeat)))
         return
     if a.profile:
         V, F = _build(a.profile, None)[0][1:]
