@@ -131,7 +131,7 @@ def _boundary_face_and_conormal(mesh, e):
     neg = f < 0
     f = np.where(neg, mesh.edge_faces[e, 1], f)
     i = np.where(neg, mesh.edge_local_index[e, 1], i)
-    return f, mesh.conormals[f, i]
+    return f, mesh.conormals_at(f, i)
 
 
 def _normalised_boundary_normals(mesh, boundary_normals, clamped):
@@ -180,8 +180,12 @@ def _boundary_rhs(mesh, rhs, clamped, N):
     rhs[bnd & ~clamped] = 0.0
     if clamped.any():
         # ξ^k = ∇_Γ id^k = P e_k, P = I - ν~ ⊗ ν~: gradients of the 3 coordinates.
-        P = np.eye(3)[None] - N[:, :, None] * N[:, None, :]   # (#V, 3, 3): row k = ξ^k
-        P[~np.isfinite(P)] = 0.0
+        # only the clamped edges' vertices are read: P there, zero elsewhere
+        v = np.unique(mesh.edges[clamped].ravel())
+        P = np.zeros((mesh.n_vertices, 3, 3))                  # (#V, 3, 3): row k = ξ^k
+        Pv = np.eye(3)[None] - N[v, :, None] * N[v, None, :]
+        Pv[~np.isfinite(Pv)] = 0.0
+        P[v] = Pv
         rhs[clamped] += clamped_load(mesh, clamped, P)[clamped]
     return rhs
 

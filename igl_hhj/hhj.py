@@ -155,7 +155,7 @@ def clamped_load(mesh: TriangleMesh, edge_mask, gradient):
     f = mesh.edge_faces[e, 0]
     f = np.where(f >= 0, f, mesh.edge_faces[e, 1])
     i = np.where(mesh.edge_faces[e, 0] >= 0, mesh.edge_local_index[e, 0], mesh.edge_local_index[e, 1])
-    n = mesh.conormals[f, i]                      # (m, 3)
+    n = mesh.conormals_at(f, i)                   # (m, 3)
     va, vb = mesh.edges[e, 0], mesh.edges[e, 1]
     xi = 0.5 * (gradient[va] + gradient[vb])      # (m, k, 3) mean over the edge
     g[e] = mesh.unique_edge_lengths[e, None] * np.einsum("ma,mka->mk", n, xi)

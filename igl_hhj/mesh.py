@@ -372,6 +372,17 @@ class TriangleMesh:
         """(#F, 3, 3) float64: unit outward conormals ``n[f, i] = t_i × ν_T`` (in the plane of T)."""
         return np.cross(self.edge_tangents, self.face_normals[:, None, :])
 
+    def conormals_at(self, f, i):
+        """(m, 3) float64: the conormals ``n[f, i]`` of :attr:`conormals` for the given
+        faces ``f`` (m,) and local edges ``i`` (m,) only, without the (#F, 3, 3) arrays
+        (the boundary edges' conormals of the clamped load)."""
+        f = np.asarray(f, dtype=np.int64)
+        i = np.asarray(i, dtype=np.int64)
+        a = self.V[self.F[f, (i + 1) % 3]]
+        t = self.V[self.F[f, (i + 2) % 3]] - a
+        t /= np.linalg.norm(t, axis=1, keepdims=True)
+        return np.cross(t, self.face_normals[f])
+
     @cached_property
     def barycentric_gradients(self):
         """(#F, 3, 3) float64: ``∇λ_i = -l_i n_i / (2|T|)``, gradient of corner i's hat function on f."""
