@@ -113,7 +113,7 @@ void edge_morton_order(const double* V, i64 nV, const i64* E, i64 nE, i64* perm)
         for (int a = 0; a < 3; ++a) {
             const double mid = 0.5 * (V[3 * E[2 * e] + a] + V[3 * E[2 * e + 1] + a]);
             double q = (mid - lo[a]) * scale;
-            q = q < 0 ? 0 : (q > CELLS ? CELLS : q);
+            q = q >= 0 ? (q > CELLS ? CELLS : q) : 0.0;     // NaN -> 0 (no UB cast)
             code |= spread3((std::uint64_t)q) << a;
         }
         key[e] = code;
