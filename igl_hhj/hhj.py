@@ -259,7 +259,8 @@ def solve_spd(A, R, *, method="auto", rtol=1e-10, maxiter=None, preconditioner=N
         approximation of A⁻¹, e.g. :func:`face_schwarz_preconditioner`) or,
         without one, Jacobi.
         "direct": one sparse factorisation (:func:`igl_hhj.solvers.cholesky_solve`:
-        SuperLU-MMD up to 80k unknowns, CHOLMOD via cholespy above).
+        QDLDL up to 200k unknowns, CHOLMOD via cholespy above, pivoted SuperLU when the
+        residual check fails).
         "auto": direct up to ``AUTO_DIRECT_MAX`` (50 000) unknowns; above,
         PCG, switching to the direct solver as soon as the measured
         convergence rate predicts more than ``maxiter`` (default
