@@ -188,7 +188,7 @@ def ell_indptr(n, width=5):
 
 def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,
               probe_iter=0, max_predicted=np.inf, subdomain=None, subdomain_solve=None,
-              overwrite_R=False):
+              subdomain_ldl=None, overwrite_R=False):
     """Fused block PCG on all columns of ``R`` (n, k ≤ 16) for a CSR matrix.
 
     Column indices travel as int32 (memory bandwidth: the sweeps are memory-bound).
@@ -197,7 +197,10 @@ def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,
     ``subdomain`` (int64 indices S) and ``subdomain_solve(r_S, z_S)`` (writes
     ``z_S = C r_S`` into its second argument, (|S|, k) float64) a second level
     ``z += R_Sᵀ C R_S r`` is added (e.g. an exact sparse solve on the DOFs of
-    badly shaped faces).
+    badly shaped faces).  Instead of ``subdomain_solve``, ``subdomain_ldl`` = ``(Lp, Li,
+    Lx, D, perm)`` gives ``C = A_SS⁻¹`` as an LDLᵀ factor ``P (I + L) D (I + L)ᵀ Pᵀ``
+    (QDLDL's layout: ``L`` strictly lower triangular CSC, ``P[perm[i], i] = 1``), solved in
+    the compiled core on all k columns at once, without a Python call per iteration.
 
     Returns
     -------
@@ -232,15 +235,22 @@ def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,
             raise ValueError(f"dinv must be ({n},), got {dinv.shape}")
     else:
         raise ValueError("block_pcg needs M or dinv")
-    S = None
+    S = ldl = None
     if subdomain is not None:
         S = _i64(subdomain)
-        if subdomain_solve is None or not callable(subdomain_solve):
-            raise TypeError("subdomain needs a callable subdomain_solve(r_S, z_S)")
+        if subdomain_ldl is not None:
+            if subdomain_solve is not None:
+                raise TypeError("give subdomain_solve or subdomain_ldl, not both")
+            if len(subdomain_ldl) != 5:
+                raise ValueError("subdomain_ldl must be (Lp, Li, Lx, D, perm)")
+            Lp, Li, Lx, D, perm = subdomain_ldl
+            ldl = (_i64(Lp), _i64(Li), _f64(Lx, "Lx"), _f64(D, "D"), _i64(perm))
+        elif subdomain_solve is None or not callable(subdomain_solve):
+            raise TypeError("subdomain needs a callable subdomain_solve(r_S, z_S) or subdomain_ldl")
     _threads()
     return _core.block_pcg(indptr, indices, data, Mp, Mi, Mx, dinv, R, float(rtol), int(maxiter),
                            int(probe_iter), float(max_predicted), S,
-                           subdomain_solve if S is not None else None)
+                           subdomain_solve if S is not None and ldl is None else None, ldl)
 
 
 def shape_operator_faces(mesh, s):

@@ -436,3 +436,75 @@ def test_direct_solve_checks_its_residual_and_falls_back_to_pivoted_lu(closed, m
     assert solvers._ldl(Z) is None
     with pytest.raises(SolverError):
         solvers.cholesky_solve(Z, np.ones(3))
+
+
+def _jittered_sliver_system():
+    """An HHJ system of a jittered sphere with enough sliver DOFs for the two-level."""
+    from igl_hhj import solvers
+    V, F = icosphere(3)
+    V = jitter_tangentially(V, F, Sphere(), 0.45, seed=7)
+    m = TriangleMesh(V, F)
+    system = HHJSystem(m)
+    return system, system.sliver_dofs(angle=30.0), -kernels.jump_apply(m, m.V)[system.perm], solvers
+
+
+def test_native_ldl_subdomain_equals_python_subdomain_solve():
+    """The two-level's sliver solve through ``subdomain_ldl`` (QDLDL's factor solved in the
+    compiled PCG, k columns at once) gives the iterates of the same factor solved from Python
+    (``subdomain_solve``), run after run."""
+    system, S, rhs, solvers = _jittered_sliver_system()
+    assert len(S) > 20
+    A = system.csr()[S][:, S].tocsr()
+    level = system._two_level(S)
+    assert set(level) == {"subdomain_ldl"}
+    py = solvers._ldl(A)
+    kw = dict(rtol=1e-10, maxiter=500, M=(system.indptr, system._cols_flat, system.M.ravel()), subdomain=S)
+    args = (system.indptr, system._cols_flat, system.A.ravel(), rhs)
+    Xn, itn, stn, _ = solvers.pcg(*args, subdomain_ldl=level["subdomain_ldl"], **kw)
+    Xp, itp, stp, _ = solvers.pcg(*args, subdomain_solve=lambda r, z: py(r, out=z), **kw)
+    assert stn == stp == 0 and abs(itn - itp) <= 1
+    assert rel(Xn, Xp) <= 1e-9
+    assert np.array_equal(Xn, solvers.pcg(*args, subdomain_ldl=level["subdomain_ldl"], **kw)[0])
+
+
+def test_two_level_falls_back_to_pivoted_lu_when_ldl_is_not_positive(monkeypatch):
+    """A sliver block whose LDLᵀ has a non-positive pivot (numerically semi-definite) is
+    solved by pivoted LU from Python instead."""
+    system, S, rhs, solvers = _jittered_sliver_system()
+    real = solvers._qdldl_factor
+
+    class Negative:
+        def __init__(self, A):
+            self.f = real(A)
+
+        def factors(self):
+            L, d, p = self.f.factors()
+            return L, np.where(np.arange(len(d)) == 0, -d, d), p
+    monkeypatch.setattr(solvers, "_qdldl_factor", Negative)
+    level = system._two_level(S)
+    assert set(level) == {"subdomain_solve"}
+    r = np.random.default_rng(0).normal(size=(len(S), 3))
+    z = np.empty_like(r)
+    level["subdomain_solve"](r, z)
+    assert rel(system.csr()[S][:, S] @ z, r) <= 1e-10
+
+
+def test_block_pcg_rejects_bad_subdomain_ldl():
+    system, S, rhs, solvers = _jittered_sliver_system()
+    L, d, perm = solvers._qdldl_factor(system.csr()[S][:, S].tocsr()).factors()
+    L = sp.csc_matrix(L)
+    good = (L.indptr, L.indices, L.data, d, perm)
+    kw = dict(rtol=1e-8, maxiter=50, M=(system.indptr, system._cols_flat, system.M.ravel()), subdomain=S)
+    args = (system.indptr, system._cols_flat, system.A.ravel(), rhs)
+    bad_perm = perm.copy()
+    bad_perm[0] = bad_perm[1]
+    upper = L.indices.copy()
+    upper[0] = 0
+    for bad, match in [((L.indptr, L.indices, L.data, d, bad_perm), "permutation"),
+                       ((L.indptr, upper, L.data, d, perm), "strictly lower"),
+                       ((L.indptr[:-1], L.indices, L.data, d, perm), "shapes"),
+                       (good[:4], "Lp, Li, Lx, D, perm")]:
+        with pytest.raises(ValueError, match=match):
+            kernels.block_pcg(*args, subdomain_ldl=bad, **kw)
+    with pytest.raises(TypeError, match="not both"):
+        kernels.block_pcg(*args, subdomain_ldl=good, subdomain_solve=lambda r, z: None, **kw)

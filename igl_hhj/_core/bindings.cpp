@@ -6,6 +6,7 @@
 #include <nanobind/stl/tuple.h>
 #include <nanobind/stl/vector.h>
 #include <nanobind/stl/optional.h>
+#include <memory>
 #include <optional>
 
 #include "core.hpp"
@@ -164,7 +165,7 @@ NB_MODULE(_hhj_core, m) {
                           std::optional<In<double>> dinv, nb::ndarray<double, nb::c_contig, nb::device::cpu> R,
                           double rtol, i64 maxiter,
                           i64 probe_iter, double max_predicted, std::optional<In<i64>> S,
-                          std::optional<nb::callable> subdomain_solve) {
+                          std::optional<nb::callable> subdomain_solve, std::optional<nb::tuple> subdomain_ldl) {
         need(R.ndim() == 2, "block_pcg: R must be (n, k)");
         const i64 n = R.shape(0);
         const int k = (int)R.shape(1);
@@ -174,7 +175,46 @@ NB_MODULE(_hhj_core, m) {
         std::vector<double> X((size_t)n * k);
         hhj::PCGResult res;
         hhj::SubdomainSolve sub;
-        if (S && subdomain_solve) {
+        // keeps the factor's arrays alive for the native solve below
+        std::optional<In<i64>> Lp, Li, perm;
+        std::optional<In<double>> Lx, D;
+        if (S && subdomain_ldl) {
+            need(subdomain_ldl->size() == 5, "block_pcg: subdomain_ldl must be (Lp, Li, Lx, D, perm)");
+            Lp = nb::cast<In<i64>>((*subdomain_ldl)[0]);
+            Li = nb::cast<In<i64>>((*subdomain_ldl)[1]);
+            Lx = nb::cast<In<double>>((*subdomain_ldl)[2]);
+            D = nb::cast<In<double>>((*subdomain_ldl)[3]);
+            perm = nb::cast<In<i64>>((*subdomain_ldl)[4]);
+            const i64 nS = (i64)S->shape(0);
+            need(Lp->ndim() == 1 && Lp->shape(0) == (size_t)nS + 1 && D->shape(0) == (size_t)nS &&
+                 perm->shape(0) == (size_t)nS && Li->shape(0) == Lx->shape(0),
+                 "block_pcg: subdomain_ldl shapes do not match S");
+            const i64* lp = Lp->data();
+            need(lp[0] == 0 && lp[nS] == (i64)Li->shape(0), "block_pcg: subdomain_ldl Lp");
+            for (i64 j = 0; j < nS; ++j) {
+                need(lp[j] <= lp[j + 1], "block_pcg: subdomain_ldl Lp not monotone");
+                for (i64 q = lp[j]; q < lp[j + 1]; ++q)
+                    need(Li->data()[q] > j && Li->data()[q] < nS, "block_pcg: subdomain_ldl L not strictly lower");
+            }
+            std::vector<unsigned char> seen(nS, 0);
+            for (i64 i = 0; i < nS; ++i) {
+                const i64 o = perm->data()[i];
+                need(o >= 0 && o < nS && !seen[o], "block_pcg: subdomain_ldl perm is not a permutation");
+                seen[o] = 1;
+            }
+            hhj::LDLFactor f;
+            f.n = nS;
+            f.Lp = lp;
+            f.Li = Li->data();
+            f.Lx = Lx->data();
+            f.D = D->data();
+            f.perm = perm->data();
+            sub.S = S->data();
+            sub.nS = nS;
+            for (i64 i = 0; i < sub.nS; ++i) need(sub.S[i] >= 0 && sub.S[i] < n, "block_pcg: S index out of range");
+            auto work = std::make_shared<std::vector<double>>((size_t)nS * k);
+            sub.solve = [f, work, k](const double* rS, double* zS) { hhj::ldl_solve_block(f, k, rS, zS, work->data()); };
+        } else if (S && subdomain_solve) {
             sub.S = S->data();
             sub.nS = (i64)S->shape(0);
             for (i64 i = 0; i < sub.nS; ++i) need(sub.S[i] >= 0 && sub.S[i] < n, "block_pcg: S index out of range");

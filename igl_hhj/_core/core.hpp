@@ -164,6 +164,19 @@ struct SubdomainSolve {
     i64 nS = 0;
     std::function<void(const double*, double*)> solve;
 };
+// A sparse LDLᵀ factor P (I + L) D (I + L)ᵀ Pᵀ (QDLDL's layout: L strictly lower, CSC;
+// perm[k] = row of A that is row k of the factor) and its block solve on k interleaved
+// columns (rS (n,k) -> zS (n,k), w scratch (n,k)): the two-level's subdomain solve without
+// a Python round trip.
+struct LDLFactor {
+    i64 n = 0;
+    const i64* Lp = nullptr;
+    const i64* Li = nullptr;
+    const double* Lx = nullptr;
+    const double* D = nullptr;
+    const i64* perm = nullptr;
+};
+void ldl_solve_block(const LDLFactor& f, int k, const double* r, double* z, double* w);
 PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const double* Ax,
                     const i64* Mp, const std::int32_t* Mi, const double* Mx, const double* dinv,
                     double* R, double* X, double rtol, i64 maxiter,

@@ -256,4 +256,32 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
     return res;
 }
 
+void ldl_solve_block(const LDLFactor& f, int k, const double* r, double* z, double* w) {
+    const i64 n = f.n;
+    for (i64 i = 0; i < n; ++i)
+        for (int c = 0; c < k; ++c) w[(size_t)i * k + c] = r[(size_t)f.perm[i] * k + c];
+    for (i64 j = 0; j < n; ++j) {                          // (I + L) u = w, column-oriented
+        const double* wj = w + (size_t)j * k;
+        for (i64 q = f.Lp[j]; q < f.Lp[j + 1]; ++q) {
+            double* wi = w + (size_t)f.Li[q] * k;
+            const double l = f.Lx[q];
+            for (int c = 0; c < k; ++c) wi[c] -= l * wj[c];
+        }
+    }
+    for (i64 i = 0; i < n; ++i) {
+        const double d = f.D[i];
+        for (int c = 0; c < k; ++c) w[(size_t)i * k + c] /= d;
+    }
+    for (i64 j = n - 1; j >= 0; --j) {                     // (I + L)ᵀ x = v, dot products
+        double* wj = w + (size_t)j * k;
+        for (i64 q = f.Lp[j]; q < f.Lp[j + 1]; ++q) {
+            const double* wi = w + (size_t)f.Li[q] * k;
+            const double l = f.Lx[q];
+            for (int c = 0; c < k; ++c) wj[c] -= l * wi[c];
+        }
+    }
+    for (i64 i = 0; i < n; ++i)
+        for (int c = 0; c < k; ++c) z[(size_t)f.perm[i] * k + c] = w[(size_t)i * k + c];
+}
+
 }  // namespace hhj
