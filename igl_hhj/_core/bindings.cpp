@@ -231,7 +231,7 @@ NB_MODULE(_hhj_core, m) {
         }
         {
             nb::gil_scoped_release nogil;
-            hhj::ThreadBudget tb(n);
+            hhj::ThreadBudget tb(n * k, hhj::PCG_MIN_WORK);
             res = hhj::block_pcg(n, k, Ap.data(), Ai.data(), Ax.data(),
                                  Mp ? Mp->data() : nullptr, Mp ? Mi->data() : nullptr,
                                  Mp ? Mx->data() : nullptr, dinv ? dinv->data() : nullptr,
