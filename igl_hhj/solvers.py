@@ -6,11 +6,13 @@ Three ways to solve, chosen per call:
   QDLDL (AMD ordering, LDLᵀ) up to :data:`LDL_MAX` unknowns, CHOLMOD (``cholespy``) above.
 * ``"cg"``: the compiled fused block PCG (:func:`igl_hhj.kernels.block_pcg`),
   preconditioned by a two-level method: the face-Schwarz preconditioner (exact
-  inverses of every face's 3×3 block of A) plus an exact sparse Cholesky solve on
-  the DOFs of the faces with a smallest angle below :data:`SLIVER_ANGLE` (where
-  A's ill-conditioning lives).  Without the second level, sliver meshes need
-  400–800 iterations (camelhead 811, bunny upsampled twice 417); with it 40–60.
-* ``"auto"`` (default): direct below :data:`AUTO_DIRECT_MAX` unknowns; otherwise
+  inverses of every face's 3×3 block of A) plus an exact sparse solve on the DOFs of
+  the faces with a smallest angle below :data:`SLIVER_ANGLE` (where A's
+  ill-conditioning lives; a QDLDL factor solved inside the compiled PCG).  Without
+  the second level, sliver meshes need 400–800 iterations (camelhead 811, bunny
+  upsampled twice 417); with it 40–60.
+* ``"auto"`` (default): direct below :data:`AUTO_DIRECT_MAX` unknowns or when more
+  than :data:`SLIVER_MAX_FRACTION` of the DOFs lie on sliver faces; otherwise
   the same PCG, which checks its convergence rate every :data:`PROBE_ITER`
   iterations and, when the iterations still needed (extrapolated from the rate so far)
   would cost more than the estimated factorisation (:func:`_direct_seconds`), stops and factorises instead.
