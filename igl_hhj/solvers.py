@@ -63,7 +63,9 @@ CG_MAXITER = 5000
 # faces with a smallest angle below this (degrees) form the sliver subdomain of the
 # two-level preconditioner (exact sparse solve on their DOFs); chosen by
 # `python -m igl_hhj.benchmarks.speed --sliver-study` (0°-25° on camelhead, the bunny
-# upsampled twice, an open scan and a jittered ellipsoid: 15-20° is fastest on all four)
+# upsampled twice, an open scan and a jittered ellipsoid: 15-20° was fastest on all four;
+# re-measured with the QDLDL sliver solve inside the PCG, 15°-30°: 20° is fastest or
+# within 8 % of 25° on all four, 30° up to 1.6x slower)
 SLIVER_ANGLE = 20.0
 # above this fraction of sliver DOFs "auto" factorises A itself: the two-level's subdomain
 # factorisation then costs a good part of the full one, with the PCG on top (open scan,
