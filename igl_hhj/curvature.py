@@ -533,6 +533,8 @@ def vertex_principal_curvature(mesh, Sv, N):
     PD1, PD2 : (#V, 3), PV1, PV2 : (#V,) as :func:`principal_from_shape_operator`.
     """
     ref = mesh.referenced_vertices
+    if ref.all():                       # no masked copies of the (#V, 3, 3) tensors
+        return principal_from_shape_operator(Sv, N)
     nV = mesh.n_vertices
     PD1 = np.full((nV, 3), np.nan)
     PD2 = np.full((nV, 3), np.nan)

@@ -116,12 +116,14 @@ def _to6(S):
     return np.stack([S[:, i, j] for i, j in _SYM], axis=1)
 
 
+# column of the 6-vector holding entry (i, j) of the symmetric tensor, row-major
+_FROM6 = np.array([[next(c for c, ij in enumerate(_SYM) if set(ij) == {i, j} and ij[0] <= ij[1])
+                    for j in range(3)] for i in range(3)]).ravel()
+
+
 def _from6(X):
-    S = np.empty((X.shape[0], 3, 3))
-    for c, (i, j) in enumerate(_SYM):
-        S[:, i, j] = X[:, c]
-        S[:, j, i] = X[:, c]
-    return S
+    """(n, 6) -> (n, 3, 3) symmetric tensors (one gather: contiguous output)."""
+    return np.take(X, _FROM6, axis=1).reshape(len(X), 3, 3)
 
 
 def _square(A, n):
