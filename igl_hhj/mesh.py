@@ -359,8 +359,9 @@ class TriangleMesh:
     @cached_property
     def unique_edge_lengths(self):
         """(#E,) float64: length of each unique edge."""
-        d = self.V[self.edges[:, 1]] - self.V[self.edges[:, 0]]
-        return np.linalg.norm(d, axis=1)
+        d = np.take(self.V, self.edges[:, 1], axis=0)
+        d -= np.take(self.V, self.edges[:, 0], axis=0)
+        return np.sqrt(np.einsum("ea,ea->e", d, d))
 
     @cached_property
     def edge_tangents(self):
