@@ -126,6 +126,9 @@ def validate_vertices(V, name="V"):
     if V.shape[0] == 0:
         raise ValueError(f"{name} is empty: the mesh has no vertices")
     V = np.ascontiguousarray(V, dtype=np.float64)
+    m = np.abs(V).max()            # one reduction: NaN propagates, inf and huge values exceed
+    if m <= COORDINATE_MAX:
+        return V
     finite = np.isfinite(V).all(axis=1)
     if not finite.all():
         i = int(np.flatnonzero(~finite)[0])
@@ -160,14 +163,13 @@ def validate_faces(F, nV, name="F"):
             raise ValueError(f"{name} has out-of-range vertex indices (#V = {nV}); "
                              f"first at face {i}: {F[i].tolist()}")
     F = np.ascontiguousarray(F, dtype=np.int64)
-    bad = (F < 0).any(axis=1)
-    if bad.any():
-        i = int(np.flatnonzero(bad)[0])
+    # two global reductions first; the per-face masks only to name the culprit
+    if F.min() < 0:
+        i = int(np.flatnonzero((F < 0).any(axis=1))[0])
         raise ValueError(f"{name} has negative vertex indices; first at face {i}: {F[i]} "
                          f"(indices are 0-based positions in V)")
-    bad = (F >= nV).any(axis=1)
-    if bad.any():
-        i = int(np.flatnonzero(bad)[0])
+    if F.max() >= nV:
+        i = int(np.flatnonzero((F >= nV).any(axis=1))[0])
         raise ValueError(f"{name} has out-of-range vertex indices (#V = {nV}); "
                          f"first at face {i}: {F[i]}")
     bad = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])

@@ -59,6 +59,8 @@ NB_MODULE(_hhj_core, m) {
     m.def("topology", [](In<i64> F, i64 nV) {
         need(F.ndim() == 2 && F.shape(1) == 3, "F must be (#F, 3)");
         const i64 nF = F.shape(0);
+        need(3 * nF < ((i64)1 << 32) && nV < ((i64)1 << 32),
+             "topology: at most 1 431 655 765 faces and 2**32 - 1 vertices");
         hhj::Topology T;
         {
             nb::gil_scoped_release nogil;

@@ -15,32 +15,38 @@ namespace hhj {
 // runs min->max).  On non-manifold edges (count > 2) the last faces win.
 void topology(const i64* F, i64 nF, i64 nV, Topology& T) {
     const i64 nH = 3 * nF;
-    std::vector<i64> start(nV + 1, 0), lo(nH), hikey(nH);
+    // half-edge h = 3f + i gets the key (hi << 32) | h, bucketed by its lower vertex: sorting
+    // the keys of a bucket sorts by (hi, h) on contiguous memory (no indirection; needs
+    // nH, nV < 2^32, checked by the binding)
+    std::vector<i64> start(nV + 1, 0), lo(nH);
+    std::vector<std::uint64_t> hikey(nH);
     for (i64 f = 0; f < nF; ++f)
         for (int i = 0; i < 3; ++i) {
             const i64 a = F[3 * f + (i + 1) % 3], b = F[3 * f + (i + 2) % 3];
             const i64 h = 3 * f + i;
             lo[h] = a < b ? a : b;
-            hikey[h] = a < b ? b : a;
+            hikey[h] = ((std::uint64_t)(a < b ? b : a) << 32) | (std::uint64_t)h;
             ++start[lo[h] + 1];
         }
     for (i64 v = 0; v < nV; ++v) start[v + 1] += start[v];
-    std::vector<i64> order(nH), fill(start.begin(), start.end() - 1);
-    for (i64 h = 0; h < nH; ++h) order[fill[lo[h]]++] = h;
-    // sort each bucket by (hi, h): buckets are small (vertex valence), insertion sort;
-    // h ascending within a bucket already (counting sort is stable)
+    std::vector<std::uint64_t> order(nH);
+    {
+        std::vector<i64> fill(start.begin(), start.end() - 1);
+        for (i64 h = 0; h < nH; ++h) order[fill[lo[h]]++] = hikey[h];
+    }
+    // sort each bucket by key = (hi, h): buckets are small (vertex valence), insertion sort
     for (i64 v = 0; v < nV; ++v) {
-        i64* b = order.data() + start[v];
+        std::uint64_t* b = order.data() + start[v];
         const i64 m = start[v + 1] - start[v];
         if (m > 32) {
-            std::stable_sort(b, b + m, [&](i64 x, i64 y) { return hikey[x] < hikey[y]; });
+            std::sort(b, b + m);
             continue;
         }
         for (i64 p = 1; p < m; ++p) {
-            const i64 h = b[p], key = hikey[h];
+            const std::uint64_t key = b[p];
             i64 q = p - 1;
-            while (q >= 0 && hikey[b[q]] > key) { b[q + 1] = b[q]; --q; }
-            b[q + 1] = h;
+            while (q >= 0 && b[q] > key) { b[q + 1] = b[q]; --q; }
+            b[q + 1] = key;
         }
     }
     T.face_edges.assign(nH, 0);
@@ -50,8 +56,8 @@ void topology(const i64* F, i64 nF, i64 nV, Topology& T) {
     i64 nE = 0, prev_lo = -1, prev_hi = -1;
     for (i64 v = 0; v < nV; ++v) {
         for (i64 p = start[v]; p < start[v + 1]; ++p) {
-            const i64 h = order[p];
-            const i64 hi = hikey[h];
+            const i64 h = (i64)(order[p] & 0xffffffffULL);
+            const i64 hi = (i64)(order[p] >> 32);
             if (v != prev_lo || hi != prev_hi) {
                 T.edges.push_back(v);
                 T.edges.push_back(hi);
