@@ -116,9 +116,15 @@ def _to6(S):
     return np.stack([S[:, i, j] for i, j in _SYM], axis=1)
 
 
-# column of the 6-vector holding entry (i, j) of the symmetric tensor, row-major
-_FROM6 = np.array([[next(c for c, ij in enumerate(_SYM) if set(ij) == {i, j} and ij[0] <= ij[1])
-                    for j in range(3)] for i in range(3)]).ravel()
+def _from6_columns():
+    """Column of the 6-vector holding entry (i, j) of the symmetric tensor, row-major (9,)."""
+    cols = np.empty((3, 3), dtype=np.int64)
+    for c, (i, j) in enumerate(_SYM):
+        cols[i, j] = cols[j, i] = c
+    return cols.ravel()
+
+
+_FROM6 = _from6_columns()
 
 
 def _from6(X):

@@ -177,6 +177,11 @@ NB_MODULE(_hhj_core, m) {
         std::vector<double> X((size_t)n * k);
         hhj::PCGResult res;
         hhj::SubdomainSolve sub;
+        if (S && (subdomain_ldl || subdomain_solve)) {
+            sub.S = S->data();
+            sub.nS = (i64)S->shape(0);
+            for (i64 i = 0; i < sub.nS; ++i) need(sub.S[i] >= 0 && sub.S[i] < n, "block_pcg: S index out of range");
+        }
         // keeps the factor's arrays alive for the native solve below
         std::optional<In<i64>> Lp, Li, perm;
         std::optional<In<double>> Lx, D;
@@ -187,7 +192,7 @@ NB_MODULE(_hhj_core, m) {
             Lx = nb::cast<In<double>>((*subdomain_ldl)[2]);
             D = nb::cast<In<double>>((*subdomain_ldl)[3]);
             perm = nb::cast<In<i64>>((*subdomain_ldl)[4]);
-            const i64 nS = (i64)S->shape(0);
+            const i64 nS = sub.nS;
             need(Lp->ndim() == 1 && Lp->shape(0) == (size_t)nS + 1 && D->shape(0) == (size_t)nS &&
                  perm->shape(0) == (size_t)nS && Li->shape(0) == Lx->shape(0),
                  "block_pcg: subdomain_ldl shapes do not match S");
@@ -211,15 +216,9 @@ NB_MODULE(_hhj_core, m) {
             f.Lx = Lx->data();
             f.D = D->data();
             f.perm = perm->data();
-            sub.S = S->data();
-            sub.nS = nS;
-            for (i64 i = 0; i < sub.nS; ++i) need(sub.S[i] >= 0 && sub.S[i] < n, "block_pcg: S index out of range");
             auto work = std::make_shared<std::vector<double>>((size_t)nS * k);
             sub.solve = [f, work, k](const double* rS, double* zS) { hhj::ldl_solve_block(f, k, rS, zS, work->data()); };
         } else if (S && subdomain_solve) {
-            sub.S = S->data();
-            sub.nS = (i64)S->shape(0);
-            for (i64 i = 0; i < sub.nS; ++i) need(sub.S[i] >= 0 && sub.S[i] < n, "block_pcg: S index out of range");
             const size_t nS = sub.nS, kk = k;
             nb::callable fn = *subdomain_solve;
             sub.solve = [fn, nS, kk](const double* rS, double* zS) {
