@@ -500,11 +500,25 @@ def test_block_pcg_rejects_bad_subdomain_ldl():
     bad_perm[0] = bad_perm[1]
     upper = L.indices.copy()
     upper[0] = 0
+    j = int(np.flatnonzero(np.diff(L.indptr) > 0)[0])      # a column with entries
+    decreasing = L.indptr.copy()
+    decreasing[j + 1] = decreasing[j] - 1 if j > 0 else decreasing[j + 2] + 1
+    shifted = L.indptr.copy()
+    shifted[0] = 1
     for bad, match in [((L.indptr, L.indices, L.data, d, bad_perm), "permutation"),
                        ((L.indptr, upper, L.data, d, perm), "strictly lower"),
+                       ((decreasing, L.indices, L.data, d, perm), "not monotone"),
+                       ((shifted, L.indices, L.data, d, perm), "subdomain_ldl Lp$"),
                        ((L.indptr[:-1], L.indices, L.data, d, perm), "shapes"),
                        (good[:4], "Lp, Li, Lx, D, perm")]:
         with pytest.raises(ValueError, match=match):
             kernels.block_pcg(*args, subdomain_ldl=bad, **kw)
     with pytest.raises(TypeError, match="not both"):
         kernels.block_pcg(*args, subdomain_ldl=good, subdomain_solve=lambda r, z: None, **kw)
+
+
+def test_topology_refuses_sizes_beyond_its_32_bit_keys():
+    """The topology kernel packs (vertex, half-edge) into 64-bit keys: more than 2**32 - 1
+    vertices (or 1.43e9 faces) is a ValueError, not a wrong answer."""
+    with pytest.raises(ValueError, match="at most"):
+        kernels.topology(np.array([[0, 1, 2]]), 2 ** 32)
