@@ -351,3 +351,12 @@ def test_benchmark_runs_on_tiny_sizes(tmp_path):
     assert (tmp_path / "r.png").stat().st_size > 1000
     bench.main(["--out", str(tmp_path / "o"), "--levels", "1", "2", "--no-plot"])
     assert (tmp_path / "o" / "regge.md").exists()
+
+
+def test_benchmark_timing_study_on_a_small_sphere():
+    """--timing: the PCG lifting equals the SuperLU lifting of the same system."""
+    from igl_hhj.benchmarks import regge_convergence as bench
+    rows = bench.timing_study(levels=(2,), repeat=1)
+    assert rows[0]["n_vertices"] == 162 and rows[0]["max_diff"] < 1e-10
+    assert all(rows[0][k] > 0 for k in ("pcg", "superlu", "igl_angle_defect"))
+    assert "gauss_curvature (PCG)" in bench.timing_markdown(rows)

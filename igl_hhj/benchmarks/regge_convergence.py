@@ -2,6 +2,7 @@
 Gopalakrishnan–Neunteufel–Schöberl–Wardetzky (2024).
 
     python -m igl_hhj.benchmarks.regge_convergence [--out DIR] [--levels 1 2 3 4 5 6] [--quick]
+    python -m igl_hhj.benchmarks.regge_convergence --timing [--timing-levels 6 7 8]
 
 Metric of the graph of ``f = (x²+y²)/2 - (x⁴+y⁴)/12`` on ``(0, 1)²``; right and
 bottom sides Dirichlet (``K̄`` prescribed), left and top Neumann (``κ̄`` and the
@@ -18,6 +19,12 @@ interpolant of degree k (eq. 3.1), ``K_h`` ∈ Lagrange ``P^p``:
 Writes ``regge.md`` (tables with the reference numbers of ``regge.md`` beside
 ours), ``regge.json`` and ``regge_convergence.png`` to ``--out`` (default
 ``./benchmark-results/``).  EOC = ``log2(e_{l-1} / e_l)`` (h halves per level).
+
+``--timing``: wall time of ``igl_hhj.regge.gauss_curvature(V, F)`` (the P1 lifting of the
+angle deficits, ``M K_h = Θ`` solved by the lumped-preconditioned compiled PCG) on
+icosphere(l), beside a sparse LU of the same mass matrix (the previous solver) and
+``igl.gaussian_curvature`` (angle deficits only, no solve), with the largest difference
+between the two liftings.
 """
 from __future__ import annotations
 
@@ -180,6 +187,50 @@ def plot(result, path):
     plt.close(fig)
 
 
+def timing_study(levels=(6, 7, 8), repeat=2):
+    """Rows of (#V, seconds of gauss_curvature, of the same lifting by SuperLU, of
+    igl.gaussian_curvature, max |difference| of the two liftings)."""
+    import igl
+    import scipy.sparse.linalg as spla
+
+    from ..mesh import TriangleMesh
+    from ..regge import gauss_curvature
+    from ..regge.edge_metric import angle_defect, intrinsic_mass_matrix
+    from ..surfaces import icosphere
+
+    def best(fn):
+        t_min, out = np.inf, None
+        for _ in range(repeat):
+            t = time.perf_counter()
+            out = fn()
+            t_min = min(t_min, time.perf_counter() - t)
+        return t_min, out
+
+    def superlu(V, F):
+        m = TriangleMesh(V, F)
+        l_sq = m.edge_lengths ** 2
+        M = intrinsic_mass_matrix(l_sq, m.F, m.n_vertices)
+        return spla.splu(M.tocsc()).solve(angle_defect(l_sq, m.F, boundary="natural"))
+
+    rows = []
+    for level in levels:
+        V, F = icosphere(level)
+        t_pcg, K = best(lambda: gauss_curvature(V, F))
+        t_lu, K_lu = best(lambda: superlu(V, F))
+        t_igl, _ = best(lambda: igl.gaussian_curvature(V, F))
+        rows.append({"n_vertices": len(V), "pcg": t_pcg, "superlu": t_lu, "igl_angle_defect": t_igl,
+                     "max_diff": float(np.abs(K - K_lu).max())})
+    return rows
+
+
+def timing_markdown(rows):
+    lines = ["| #V | gauss_curvature (PCG) s | same lifting by SuperLU s | igl.gaussian_curvature s | max diff |",
+             "|---|---|---|---|---|"]
+    lines += [f"| {r['n_vertices']:,} | {r['pcg']:.3f} | {r['superlu']:.3f} | {r['igl_angle_defect']:.3f} | "
+              f"{r['max_diff']:.1e} |" for r in rows]
+    return "\n".join(lines)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--out", default="benchmark-results", help="output folder (default ./benchmark-results/)")
@@ -187,7 +238,14 @@ def main(argv=None):
                     help="mesh levels l (2^l x 2^l squares, each cut in two; default 1-6)")
     ap.add_argument("--quick", action="store_true", help="levels 1-4 only")
     ap.add_argument("--no-plot", action="store_true", help="no matplotlib plot")
+    ap.add_argument("--timing", action="store_true",
+                    help="only the timing of gauss_curvature on icosphere meshes")
+    ap.add_argument("--timing-levels", type=int, nargs="+", default=[6, 7, 8],
+                    help="icosphere levels of --timing (default 6 7 8: 41k, 164k, 655k vertices)")
     args = ap.parse_args(argv)
+    if args.timing:
+        print(timing_markdown(timing_study(args.timing_levels)))
+        return
     levels = [1, 2, 3, 4] if args.quick else args.levels
     res = run(levels=levels, progress=True)
     out = Path(args.out)
