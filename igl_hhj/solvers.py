@@ -69,7 +69,7 @@ CG_MAXITER = 5000
 SLIVER_ANGLE = 20.0
 # above this fraction of sliver DOFs "auto" factorises A itself: the two-level's subdomain
 # factorisation then costs a good part of the full one, with the PCG on top (open scan,
-# 52 % sliver DOFs: direct 137 ms, two-level PCG 171 ms; camelhead, 26 %: 74 / 70 ms)
+# 52 % sliver DOFs: S_h direct 0.12 s, two-level PCG 0.15 s in `speed`; camelhead, 26 %: 0.06 / 0.06 s)
 SLIVER_MAX_FRACTION = 0.4
 
 

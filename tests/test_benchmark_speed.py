@@ -28,3 +28,15 @@ def test_rtol_study_small():
     assert all(r["change"] == 0 for r in tight)
     assert all(lo["iterations"] < ti["iterations"] for lo, ti in zip(loose, tight))
     assert "change vs rtol 1e-12" in speed.rtol_markdown(rows)
+
+
+def test_profile_stages_follows_the_default_drop_in():
+    """--profile: every stage of the default drop-in timed, with its iterations and faults."""
+    from igl_hhj.benchmarks.speed import profile_stages
+    from igl_hhj.surfaces import icosphere
+    out = profile_stages(*icosphere(3))
+    for key in ("validation + topology", "HHJ solve (auto)", "patch recovery",
+                "smoothing (4 Jacobi-CG solves)", "2x2 eigen"):
+        assert out[key] > 0
+    assert out["smoothing iterations"] > 0 and out["HHJ solver"] in ("direct", "cg")
+    assert out["minor page faults"] == sum(out["page faults per stage"].values())

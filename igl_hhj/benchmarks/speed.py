@@ -98,6 +98,9 @@ def _build(name, mesh_dir):
             return []
         V, F = igl.read_triangle_mesh(str(p))
         return [(name, *igl.upsample(V, F, 2))]
+    if (mesh_dir / name).is_file():              # one mesh of the folder, e.g. camelhead.off
+        V, F = igl.read_triangle_mesh(str(mesh_dir / name))
+        return [(name, V, F)]
     if name == "real":
         out = []
         for p in sorted(mesh_dir.glob("*.off")):
@@ -266,7 +269,7 @@ def rtol_markdown(rows):
     return "\n".join(lines)
 
 
-SLIVER_ANGLES = (0, 5, 10, 15, 20, 25)
+SLIVER_ANGLES = (0, 5, 10, 15, 20, 25, 30)
 SLIVER_MESHES = ("camelhead.off", "bunny upsampled ×2", "open scan-like height field", "jittered ellipsoid")
 
 
@@ -345,30 +348,50 @@ def factor_markdown(rows):
 
 
 def profile_stages(V, F, rtol=None):
-    """CPU seconds (single thread) of the drop-in's stages on one mesh."""
-    from igl_hhj import kernels, solvers
+    """Wall seconds (default threads) and minor page faults of the default drop-in's stages
+    on one mesh, in the drop-in's order: validation, estimated boundary normals (open
+    meshes), HHJ assembly, load, the ``auto`` solve (its iterations), S_h, vertex normals,
+    reliability weights, patch recovery, smoothing coefficients, the twiced smoothing (its
+    Jacobi-CG iterations over the four solves), 2×2 eigen.  A warm-up call runs first."""
+    import resource
+
+    from igl_hhj import kernels, principal_curvature, recovery, solvers
+    from igl_hhj.boundary_estimation import estimate_boundary_normals
     from igl_hhj.mesh import TriangleMesh
-    threads = kernels.max_threads()
-    kernels.set_num_threads(1)
-    out = {}
+    principal_curvature(V, F)                      # warm-up: imports, first-touch of the heap
+    out, faults = {}, {}
 
     def stage(name, fn):
-        t = time.process_time()
+        f0 = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+        t = time.perf_counter()
         r = fn()
-        out[name] = time.process_time() - t
+        out[name] = time.perf_counter() - t
+        faults[name] = resource.getrusage(resource.RUSAGE_SELF).ru_minflt - f0
         return r
-    try:
-        m = stage("validation + topology", lambda: (TriangleMesh(V, F), None)[0])
-        system = stage("HHJ assembly + preconditioner", lambda: solvers.HHJSystem(m))
-        rhs = stage("load -B X", lambda: -kernels.jump_apply(m, m.V))
-        s, info = stage("PCG", lambda: system.solve(rhs, "cg", rtol or solvers.DEFAULT_RTOL))
-        S = stage("S_h", lambda: kernels.shape_operator_faces(m, s))
-        N = stage("vertex normals", lambda: m.vertex_normals)
-        Sv = stage("recovery", lambda: kernels.lumped_vertex_recovery(m, S, N))
-        stage("2x2 eigen", lambda: kernels.principal_2x2(Sv, N))
-        out["PCG iterations"] = info["iterations"]
-    finally:
-        kernels.set_num_threads(threads)
+    m = stage("validation + topology", lambda: (TriangleMesh(V, F), None)[0])
+    if m.has_boundary:
+        stage("boundary normals (estimate)", lambda: estimate_boundary_normals(m))
+    system = stage("HHJ assembly + preconditioner", lambda: solvers.HHJSystem(m))
+    rhs = stage("load -B X", lambda: -kernels.jump_apply(m, m.V))
+    s, info = stage("HHJ solve (auto)", lambda: system.solve(rhs, "auto", rtol or solvers.DEFAULT_RTOL))
+    S = stage("S_h", lambda: kernels.shape_operator_faces(m, s))
+    N = stage("vertex normals", lambda: m.vertex_normals)
+    w = stage("reliability weights", lambda: kernels.recovery_weights(m, recovery.QUALITY_FLOOR))
+    X = stage("patch recovery", lambda: kernels.patch_recovery(m, S, N, w))
+    C, mass = stage("smoothing coefficients", lambda: recovery.smoothing_coefficients(m, w))
+    length = recovery.smoothing_length(m, 5)
+    status, its = stage("smoothing (4 Jacobi-CG solves)", lambda: kernels.smooth_vertex_tensors(
+        m, X, C, mass, length ** 2 / recovery.SMOOTHING_STEPS, recovery.SMOOTHING_STEPS,
+        recovery._kernel_coefficients(recovery.SMOOTHING_ORDER), 3e-3, 500))
+    kernels.tangent_projection6(m, X, N)
+    Sv = recovery._from6(X)
+    stage("2x2 eigen", lambda: kernels.principal_2x2(Sv, N))
+    out["total of the stages"] = sum(out.values())
+    out["HHJ solver"] = info["solver"]
+    out["HHJ PCG iterations"] = info["iterations"]
+    out["smoothing iterations"] = its
+    out["minor page faults"] = sum(faults.values())
+    out["page faults per stage"] = faults
     return out
 
 
@@ -403,7 +426,8 @@ def main(argv=None):
     p.add_argument("--factor-study", action="store_true",
                    help="only factorisation / solve times of the HHJ matrix: QDLDL, CHOLMOD, SuperLU")
     p.add_argument("--profile", default=None, metavar="MESH",
-                   help="only the CPU time of each stage on one mesh, e.g. 'icosphere(8)'")
+                   help="only the wall time, iterations and page faults of each stage of the default "
+                        "drop-in on one mesh, e.g. 'icosphere(8)'")
     p.add_argument("--rtol-study", action="store_true",
                    help="only the tolerance study (PCG iterations and error vs rtol)")
     a = p.parse_args(argv)
@@ -418,7 +442,7 @@ def main(argv=None):
         print(factor_markdown(factor_study(mesh_dir=a.meshes, repeat=a.repeat)))
         return
     if a.profile:
-        V, F = _build(a.profile, None)[0][1:]
+        V, F = _build(a.profile, _default_mesh_dir() if a.meshes is None else Path(a.meshes))[0][1:]
         for k, v in profile_stages(V, F).items():
             print(f"{k}: {v:.3f}" if isinstance(v, float) else f"{k}: {v}")
         return
