@@ -78,6 +78,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from . import kernels
 from .hhj import SolverDidNotConverge
 from .mesh import as_mesh
 from .solvers import _cholmod, mass_solver
@@ -616,6 +617,7 @@ class BiharmonicSolver:
         return x[self._A]
 
 
+@kernels.with_large_call_heap
 def biharmonic_solve(V, F, f, *, bc="clamped", mass="full", g=None, q=None, w=None,
                      project_mean=False, solver="auto", rtol=1e-10):
     """Solve ``Δ²u = f`` on a triangle mesh with the mixed P1 method (Stein et al. 2022).

@@ -248,6 +248,7 @@ def _check_rtol(rtol):
 
 
 # --------------------------------------------------------------------------- public API
+@kernels.with_large_call_heap
 def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary: str = "estimate",
                    boundary_normals: ArrayLike | None = None,
                    boundary_shape_operator: ArrayLike | None = None, simply_supported: ArrayLike | None = None,
@@ -337,6 +338,7 @@ def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary: str = "estim
     return S
 
 
+@kernels.with_large_call_heap
 def surface_hessian(V: Any, F: ArrayLike | None, w: ArrayLike, *, boundary_gradient: ArrayLike | None = None,
                     solver: str = "auto", rtol: float = DEFAULT_RTOL) -> NDArray[np.float64]:
     """HHJ projection of the surface Hessian ∇_Γ∇_Γ w of a P1 function (Walker eq. 4.9).
@@ -442,6 +444,7 @@ def _principal_from_shape_operator_reference(S, normals):
     return PD1, PD2, PV1, PV2
 
 
+@kernels.with_large_call_heap
 def face_principal_curvature(V: Any, F: ArrayLike | None = None, *, smoothing: float = 0,
                              **boundary: Any) -> tuple[NDArray[np.float64], ...]:
     """Per-face principal curvatures and directions from the HHJ shape operator.
@@ -598,6 +601,7 @@ def _vertex_shape_operator_reference(mesh, S):
     return Sv, N
 
 
+@kernels.with_large_call_heap
 def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, useKring: bool = True, *,
                         boundary: str = "estimate",
                         boundary_normals: ArrayLike | None = None, boundary_shape_operator: ArrayLike | None = None,

@@ -522,3 +522,72 @@ def test_topology_refuses_sizes_beyond_its_32_bit_keys():
     vertices (or 1.43e9 faces) is a ValueError, not a wrong answer."""
     with pytest.raises(ValueError, match="at most"):
         kernels.topology(np.array([[0, 1, 2]]), 2 ** 32)
+
+
+# --- large-call heap scope (igl_hhj/_core/heap.cpp) -------------------------------------
+
+def test_large_call_heap_engages_only_above_glibc_ceiling(monkeypatch):
+    monkeypatch.delenv("MALLOC_MMAP_THRESHOLD_", raising=False)
+    monkeypatch.delenv("MALLOC_TRIM_THRESHOLD_", raising=False)
+    monkeypatch.delenv("GLIBC_TUNABLES", raising=False)
+    with kernels.large_call_heap(100_000) as active:      # (#E, 3) arrays of 3.6 MB
+        assert active is False
+        assert kernels._core.heap_scope_depth() == 0
+    on_glibc = sys.platform.startswith("linux")
+    with kernels.large_call_heap(1_000_000) as active:    # 36 MB > 32 MiB
+        assert kernels._core.heap_scope_depth() == 1
+        assert active is on_glibc
+        with kernels.large_call_heap(2_000_000):           # nests
+            assert kernels._core.heap_scope_depth() == 2
+        assert kernels._core.heap_scope_depth() == 1
+    assert kernels._core.heap_scope_depth() == 0
+    monkeypatch.setattr(kernels, "LARGE_CALL_HEAP", False)
+    with kernels.large_call_heap(10_000_000) as active:
+        assert active is False and kernels._core.heap_scope_depth() == 0
+
+
+def test_large_call_heap_leaves_a_user_malloc_policy_alone(monkeypatch):
+    for var, value in (("MALLOC_MMAP_THRESHOLD_", "1000000"),
+                       ("GLIBC_TUNABLES", "glibc.malloc.trim_threshold=1000000")):
+        with monkeypatch.context() as mp:
+            mp.setenv(var, value)
+            with kernels.large_call_heap(10_000_000) as active:
+                assert active is False and kernels._core.heap_scope_depth() == 0
+
+
+def test_large_call_heap_closes_on_errors_and_across_threads(monkeypatch):
+    monkeypatch.setattr(kernels, "_GLIBC_MMAP_CEILING", 0)   # engage on small meshes
+    V, F = icosphere(2)
+    with pytest.raises(ValueError):
+        igl_hhj.principal_curvature(V, F[:, :2])
+    assert kernels._core.heap_scope_depth() == 0
+    errors = []
+
+    def work():
+        try:
+            for _ in range(3):
+                igl_hhj.principal_curvature(V, F)
+        except Exception as exc:   # pragma: no cover - reported below
+            errors.append(exc)
+    threads = [threading.Thread(target=work) for _ in range(3)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors
+    assert kernels._core.heap_scope_depth() == 0
+
+
+def test_large_call_heap_does_not_change_results(monkeypatch):
+    V, F = icosphere(3)
+    V = jitter_tangentially(V, F, Sphere(), 0.3, seed=3)
+    monkeypatch.setattr(kernels, "LARGE_CALL_HEAP", False)
+    ref = igl_hhj.principal_curvature(V, F)
+    S_ref = igl_hhj.shape_operator(V, F)
+    monkeypatch.setattr(kernels, "LARGE_CALL_HEAP", True)
+    monkeypatch.setattr(kernels, "_GLIBC_MMAP_CEILING", 0)
+    out = igl_hhj.principal_curvature(V, F)
+    for a, b in zip(ref[:4], out[:4]):
+        np.testing.assert_array_equal(a, b)
+    assert ref[4] == out[4]
+    np.testing.assert_array_equal(S_ref, igl_hhj.shape_operator(V, F))

@@ -56,6 +56,15 @@ NB_MODULE(_hhj_core, m) {
 #endif
     });
 
+    m.def("heap_scope_enter", [](size_t threshold) {
+        return hhj::heap_scope_enter(threshold);
+    }, "mmap_threshold"_a);
+    m.def("heap_scope_exit", []() {
+        nb::gil_scoped_release release;     // malloc_trim walks the heap
+        return hhj::heap_scope_exit();
+    });
+    m.def("heap_scope_depth", []() { return hhj::heap_scope_depth(); });
+
     m.def("topology", [](In<i64> F, i64 nV) {
         need(F.ndim() == 2 && F.shape(1) == 3, "F must be (#F, 3)");
         const i64 nF = F.shape(0);

@@ -189,4 +189,11 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
                     i64 probe_iter, double max_predicted, int nt,
                     const SubdomainSolve* sub = nullptr);
 
+// Large-call heap scope (heap.cpp): raise glibc's mmap threshold while open; the last
+// exit restores glibc's 32 MiB ceiling and trims.  enter returns whether it is raised,
+// exit whether this exit restored and trimmed.
+bool heap_scope_enter(std::size_t mmap_threshold);
+bool heap_scope_exit();
+int heap_scope_depth();
+
 }  // namespace hhj
