@@ -467,6 +467,38 @@ def test_native_ldl_subdomain_equals_python_subdomain_solve():
     assert np.array_equal(Xn, solvers.pcg(*args, subdomain_ldl=level["subdomain_ldl"], **kw)[0])
 
 
+def test_native_ldl_subdomain_is_bit_identical_for_one_and_two_threads(monkeypatch):
+    """Above the PCG's thread threshold the sliver factor is solved by two threads, one per
+    group of elimination trees (scattered slivers: many trees); the iterates are the same
+    bits as with one thread, and agree with the factor solved from Python."""
+    from igl_hhj import solvers
+    V, F = icosphere(6)
+    V = jitter_tangentially(V, F, Sphere(), 0.45, seed=7)
+    m = TriangleMesh(V, F)
+    system = HHJSystem(m)
+    S = system.sliver_dofs(angle=30.0)
+    rhs = -kernels.jump_apply(m, m.V)[system.perm]
+    assert system.n * 3 >= 200_000 and len(S) > 1000
+    level = system._two_level(S)
+    assert set(level) == {"subdomain_ldl"}
+    kw = dict(rtol=1e-10, maxiter=500, M=(system.indptr, system._cols_flat, system.M.ravel()), subdomain=S)
+    args = (system.indptr, system._cols_flat, system.A.ravel(), rhs)
+    monkeypatch.setattr(kernels, "ADAPT_TO_LOAD", False)
+    nt = kernels.max_threads()
+    try:
+        kernels.set_num_threads(1)
+        one = solvers.pcg(*args, subdomain_ldl=level["subdomain_ldl"], **kw)
+        kernels.set_num_threads(2)
+        two = solvers.pcg(*args, subdomain_ldl=level["subdomain_ldl"], **kw)
+    finally:
+        kernels.set_num_threads(nt)
+    assert one[2] == two[2] == 0 and one[1] == two[1]
+    assert np.array_equal(one[0], two[0])
+    py = solvers._ldl(system.csr()[S][:, S].tocsr())
+    ref = solvers.pcg(*args, subdomain_solve=lambda r, z: py(r, out=z), **kw)
+    assert rel(two[0], ref[0]) <= 1e-9
+
+
 def test_two_level_falls_back_to_pivoted_lu_when_ldl_is_not_positive(monkeypatch):
     """A sliver block whose LDLᵀ has a non-positive pivot (numerically semi-definite) is
     solved by pivoted LU from Python instead."""

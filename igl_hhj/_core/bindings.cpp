@@ -225,12 +225,16 @@ NB_MODULE(_hhj_core, m) {
             f.Lx = Lx->data();
             f.D = D->data();
             f.perm = perm->data();
+            hhj::ldl_schedule(f);
             auto work = std::make_shared<std::vector<double>>((size_t)nS * k);
-            sub.solve = [f, work, k](const double* rS, double* zS) { hhj::ldl_solve_block(f, k, rS, zS, work->data()); };
+            auto fac = std::make_shared<const hhj::LDLFactor>(std::move(f));
+            sub.solve = [fac, work, k](const double* rS, double* zS, int nt) {
+                hhj::ldl_solve_block(*fac, k, rS, zS, work->data(), nt);
+            };
         } else if (S && subdomain_solve) {
             const size_t nS = sub.nS, kk = k;
             nb::callable fn = *subdomain_solve;
-            sub.solve = [fn, nS, kk](const double* rS, double* zS) {
+            sub.solve = [fn, nS, kk](const double* rS, double* zS, int) {
                 nb::gil_scoped_acquire gil;
                 // rS is a scratch buffer: writable, so that solvers taking writable input accept it
                 nb::ndarray<nb::numpy, double> a(const_cast<double*>(rS), {nS, kk});

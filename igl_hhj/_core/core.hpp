@@ -164,16 +164,21 @@ struct PCGResult {
     std::vector<double> relres;  // per column
 };
 // Optional second level of the preconditioner: z += R_S^T C (R_S r) on the index set S,
-// C given as a function (rS (nS,k) -> zS (nS,k)), e.g. an exact sparse solve.
+// C given as a function (rS (nS,k) -> zS (nS,k), threads it may use), e.g. an exact
+// sparse solve.
 struct SubdomainSolve {
     const i64* S = nullptr;
     i64 nS = 0;
-    std::function<void(const double*, double*)> solve;
+    std::function<void(const double*, double*, int)> solve;
 };
 // A sparse LDLᵀ factor P (I + L) D (I + L)ᵀ Pᵀ (QDLDL's layout: L strictly lower, CSC;
 // perm[k] = row of A that is row k of the factor) and its block solve on k interleaved
 // columns (rS (n,k) -> zS (n,k), w scratch (n,k)): the two-level's subdomain solve without
 // a Python round trip.
+// group[0], group[1]: the factor's columns split by elimination tree (ldl_schedule), each
+// in ascending order; a tree's columns only update rows of the same tree, so the two
+// groups are solved by two threads with the same operations in the same order (the same
+// bits as one thread).
 struct LDLFactor {
     i64 n = 0;
     const i64* Lp = nullptr;
@@ -181,8 +186,12 @@ struct LDLFactor {
     const double* Lx = nullptr;
     const double* D = nullptr;
     const i64* perm = nullptr;
+    std::vector<i64> group[2];
 };
-void ldl_solve_block(const LDLFactor& f, int k, const double* r, double* z, double* w);
+// Fill f.group: elimination trees (parent of column j = its smallest row index) assigned
+// greedily, heaviest first, to the group with less work (nonzeros + 1 per column).
+void ldl_schedule(LDLFactor& f);
+void ldl_solve_block(const LDLFactor& f, int k, const double* r, double* z, double* w, int nt);
 PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const double* Ax,
                     const i64* Mp, const std::int32_t* Mi, const double* Mx, const double* dinv,
                     double* R, double* X, double rtol, i64 maxiter,

@@ -174,15 +174,21 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
         apply_and_dot(n, k, Mp, Mi, Mx, dinv, r, fused ? p.data() : z.data(), r, P, nt);
         P.reduce(out);
         if (rS.empty()) return;
-        for (i64 i = 0; i < sub->nS; ++i)
+        const i64 nS = sub->nS;
+        const int nts = nS * k >= PCG_MIN_WORK / 8 ? nt : 1;     // copies: S is unique
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nts)
+#endif
+        for (i64 i = 0; i < nS; ++i)
             for (int j = 0; j < k; ++j) rS[(size_t)i * k + j] = r[(size_t)sub->S[i] * k + j];
-        sub->solve(rS.data(), zS.data());
-        for (i64 i = 0; i < sub->nS; ++i)
-            for (int j = 0; j < k; ++j) {
-                const size_t s = (size_t)sub->S[i] * k + j;
-                z[s] += zS[(size_t)i * k + j];
-                out[j] += rS[(size_t)i * k + j] * zS[(size_t)i * k + j];
-            }
+        sub->solve(rS.data(), zS.data(), nt);
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nts)
+#endif
+        for (i64 i = 0; i < nS; ++i)
+            for (int j = 0; j < k; ++j) z[(size_t)sub->S[i] * k + j] += zS[(size_t)i * k + j];
+        for (i64 i = 0; i < nS; ++i)                              // serial: a fixed order
+            for (int j = 0; j < k; ++j) out[j] += rS[(size_t)i * k + j] * zS[(size_t)i * k + j];
     };
     precondition(rz);   // fused: p = dinv r directly
     if (!fused) std::copy(z.begin(), z.end(), p.begin());
@@ -256,32 +262,75 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
     return res;
 }
 
-void ldl_solve_block(const LDLFactor& f, int k, const double* r, double* z, double* w) {
+void ldl_schedule(LDLFactor& f) {
     const i64 n = f.n;
-    for (i64 i = 0; i < n; ++i)
-        for (int c = 0; c < k; ++c) w[(size_t)i * k + c] = r[(size_t)f.perm[i] * k + c];
-    for (i64 j = 0; j < n; ++j) {                          // (I + L) u = w, column-oriented
-        const double* wj = w + (size_t)j * k;
-        for (i64 q = f.Lp[j]; q < f.Lp[j + 1]; ++q) {
-            double* wi = w + (size_t)f.Li[q] * k;
-            const double l = f.Lx[q];
-            for (int c = 0; c < k; ++c) wi[c] -= l * wj[c];
+    std::vector<i64> root(n), work;
+    std::vector<i64> parent(n, -1);
+    for (i64 j = 0; j < n; ++j)
+        for (i64 q = f.Lp[j]; q < f.Lp[j + 1]; ++q)
+            if (parent[j] < 0 || f.Li[q] < parent[j]) parent[j] = f.Li[q];
+    std::vector<i64> tree_work(n, 0);
+    for (i64 j = n - 1; j >= 0; --j) root[j] = parent[j] < 0 ? j : root[parent[j]];
+    for (i64 j = 0; j < n; ++j) tree_work[root[j]] += f.Lp[j + 1] - f.Lp[j] + 1;
+    std::vector<i64> roots;
+    for (i64 j = 0; j < n; ++j)
+        if (parent[j] < 0) roots.push_back(j);
+    // heaviest first, ties by column: a deterministic assignment
+    std::sort(roots.begin(), roots.end(), [&](i64 a, i64 b) {
+        return tree_work[a] != tree_work[b] ? tree_work[a] > tree_work[b] : a < b;
+    });
+    std::vector<unsigned char> side(n, 0);
+    i64 load[2] = {0, 0};
+    for (i64 t : roots) {
+        const int g = load[1] < load[0] ? 1 : 0;
+        side[t] = (unsigned char)g;
+        load[g] += tree_work[t];
+    }
+    f.group[0].clear();
+    f.group[1].clear();
+    for (i64 j = 0; j < n; ++j) f.group[side[root[j]]].push_back(j);
+}
+
+void ldl_solve_block(const LDLFactor& f, int k, const double* r, double* z, double* w, int nt) {
+    // both groups non-empty: one thread each (a group's columns touch only its own rows of w)
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static, 1) num_threads(nt > 1 && !f.group[1].empty() ? 2 : 1)
+#endif
+    for (int g = 0; g < 2; ++g) {
+        const std::vector<i64>& cols = f.group[g];
+        const i64 m = (i64)cols.size();
+        for (i64 t = 0; t < m; ++t) {
+            const i64 i = cols[t];
+            for (int c = 0; c < k; ++c) w[(size_t)i * k + c] = r[(size_t)f.perm[i] * k + c];
+        }
+        for (i64 t = 0; t < m; ++t) {                        // (I + L) u = w, column-oriented
+            const i64 j = cols[t];
+            const double* wj = w + (size_t)j * k;
+            for (i64 q = f.Lp[j]; q < f.Lp[j + 1]; ++q) {
+                double* wi = w + (size_t)f.Li[q] * k;
+                const double l = f.Lx[q];
+                for (int c = 0; c < k; ++c) wi[c] -= l * wj[c];
+            }
+        }
+        for (i64 t = 0; t < m; ++t) {
+            const i64 i = cols[t];
+            const double d = f.D[i];
+            for (int c = 0; c < k; ++c) w[(size_t)i * k + c] /= d;
+        }
+        for (i64 t = m - 1; t >= 0; --t) {                   // (I + L)ᵀ x = v, dot products
+            const i64 j = cols[t];
+            double* wj = w + (size_t)j * k;
+            for (i64 q = f.Lp[j]; q < f.Lp[j + 1]; ++q) {
+                const double* wi = w + (size_t)f.Li[q] * k;
+                const double l = f.Lx[q];
+                for (int c = 0; c < k; ++c) wj[c] -= l * wi[c];
+            }
+        }
+        for (i64 t = 0; t < m; ++t) {
+            const i64 i = cols[t];
+            for (int c = 0; c < k; ++c) z[(size_t)f.perm[i] * k + c] = w[(size_t)i * k + c];
         }
     }
-    for (i64 i = 0; i < n; ++i) {
-        const double d = f.D[i];
-        for (int c = 0; c < k; ++c) w[(size_t)i * k + c] /= d;
-    }
-    for (i64 j = n - 1; j >= 0; --j) {                     // (I + L)ᵀ x = v, dot products
-        double* wj = w + (size_t)j * k;
-        for (i64 q = f.Lp[j]; q < f.Lp[j + 1]; ++q) {
-            const double* wi = w + (size_t)f.Li[q] * k;
-            const double l = f.Lx[q];
-            for (int c = 0; c < k; ++c) wj[c] -= l * wi[c];
-        }
-    }
-    for (i64 i = 0; i < n; ++i)
-        for (int c = 0; c < k; ++c) z[(size_t)f.perm[i] * k + c] = w[(size_t)i * k + c];
 }
 
 }  // namespace hhj
