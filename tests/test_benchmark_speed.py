@@ -5,12 +5,14 @@ from igl_hhj.benchmarks import speed
 
 
 def test_speed_run_quick():
-    rows = speed.run(speed.QUICK, repeat=1, progress=False, memory=True)
+    rows = speed.run(speed.QUICK, repeat=1, progress=False, memory=True, fresh=2)
     assert len(rows) == 3
     for r in rows:
         assert r["libigl"] > 0 and r["dropin"] > 0 and r["S_auto"] > 0 and r["S_cg"] > 0
         assert r["chosen"].split()[0] in ("cg", "direct") and r["iterations"] >= 0
         assert r["kb_per_face"] > 0 and r["first_over_later"] > 0 and 0 < r["min_angle"] < 60
+        assert len(r["first_over_later_runs"]) == 2       # the median of two fresh processes
+        assert r["first_over_later"] == np.median(r["first_over_later_runs"])
     table = speed.markdown(rows)
     assert table.count("\n") == len(rows) + 1 and "peak KB/face" in table
 
@@ -26,6 +28,8 @@ def test_rtol_study_small():
     tight = [r for r in rows if r["rtol"] == 1e-12]
     loose = [r for r in rows if r["rtol"] == 1e-4]
     assert all(r["change"] == 0 for r in tight)
+    assert all(r["deviation"] == 0 for r in tight)
+    assert all(0 < lo["deviation"] < 0.5 for lo in loose)
     assert all(lo["iterations"] < ti["iterations"] for lo, ti in zip(loose, tight))
     assert "change vs rtol 1e-12" in speed.rtol_markdown(rows)
 
@@ -38,5 +42,6 @@ def test_profile_stages_follows_the_default_drop_in():
     for key in ("validation + topology", "HHJ solve (auto)", "patch recovery",
                 "smoothing (4 Jacobi-CG solves)", "2x2 eigen"):
         assert out[key] > 0
+    assert out["large-call heap scope"] is False          # 1280 faces: below glibc's ceiling
     assert out["smoothing iterations"] > 0 and out["HHJ solver"] in ("direct", "cg")
     assert out["minor page faults"] == sum(out["page faults per stage"].values())
