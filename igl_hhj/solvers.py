@@ -35,7 +35,6 @@ import time
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 try:  # imported here, not in the first solve (first call ≈ later calls, issue 16)
     from cholespy import CholeskySolverD, MatrixType
@@ -109,6 +108,11 @@ def _splu(A):
     """SuperLU with partial pivoting and its default COLAMD ordering (the fallback for
     numerically semi-definite matrices; the symmetric minimum-degree ordering loses its
     sparsity under pivoting: 30 s instead of 0.25 s on the open scan)."""
+    # imported here, not with the module: scipy.sparse.linalg loads scipy's OpenBLAS, whose
+    # worker threads spin for a while after loading and, on a 2-core machine, slowed the
+    # libigl calls of a drop-in call made just after import by 4-8 ms each (fandisk: first
+    # call 1.5x the later ones); the drop-in's usual path never needs it
+    import scipy.sparse.linalg as spla
     try:
         return spla.splu(sp.csc_matrix(A)).solve
     except RuntimeError as exc:

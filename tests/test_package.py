@@ -10,6 +10,19 @@ def test_import_is_light():
     assert out.stdout.strip() == "False"
 
 
+
+def test_dropin_path_does_not_load_scipys_blas():
+    """The drop-in's usual path (PCG, QDLDL) never needs scipy.sparse.linalg: it is imported
+    only by the pivoted-LU fallback, because loading it starts scipy's OpenBLAS threads,
+    which spin for a while and slowed the first call after import (fandisk 1.5x)."""
+    code = ("import sys; from igl_hhj import principal_curvature; "
+            "from igl_hhj.surfaces import icosphere, Sphere, jitter_tangentially; "
+            "v, f = icosphere(4); principal_curvature(jitter_tangentially(v, f, Sphere(), 0.45, seed=7), f); "
+            "print('scipy.sparse.linalg' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
+
+
 def test_lazy_attributes():
     import igl_hhj
     assert callable(igl_hhj.biharmonic_solve)

@@ -15,8 +15,8 @@ For each mesh it prints: the smallest angle; the best-of-``--repeat`` wall time 
 ``t_libigl / t_drop-in`` (> 1: igl_hhj is faster); µs per face; the time of
 ``igl_hhj.shape_operator`` with ``solver="direct"``, ``"cg"`` and ``"auto"`` (auto must
 never be slower than both); what "auto" chose and its PCG iterations; the peak memory of
-one drop-in call above the input (KB per face, in a fresh subprocess after a warm-up call
-on a tiny mesh: the peak resident size ``VmHWM``, reset just before the call, minus the
+one drop-in call above the input (KB per face, in a fresh subprocess after warm-up calls
+on three small meshes that take every solver path: the peak resident size ``VmHWM``, reset just before the call, minus the
 resident size before it), how much slower
 the first call in a fresh process is than the best later one, and the time of
 ``from igl_hhj import principal_curvature`` there (which imports what the call needs),
@@ -148,8 +148,15 @@ _CHILD_MEMORY = r"""
 import json, sys
 import numpy as np
 import igl_hhj
-from igl_hhj.surfaces import icosphere
-igl_hhj.principal_curvature(*icosphere(2))        # imports and one-time set-up
+from igl_hhj.benchmarks.speed import _open_scan
+from igl_hhj.surfaces import Sphere, icosphere, jitter_tangentially
+# imports and one-time set-up (library code paged in) of every path a call may take:
+# plain PCG, the two-level sliver solve (a jittered icosphere(4)), boundary estimation
+# and the direct solve (the 5k open scan)
+igl_hhj.principal_curvature(*icosphere(2))
+v, f = icosphere(4)
+igl_hhj.principal_curvature(jitter_tangentially(v, f, Sphere(), 0.45, seed=7), f)
+igl_hhj.principal_curvature(*_open_scan(36))
 d = np.load(sys.argv[1]); V, F = d["V"], d["F"]
 def status(key):
     with open("/proc/self/status") as fh:
@@ -168,8 +175,9 @@ def _child_measure(V, F, repeat, fresh=3):
     """In ``fresh`` fresh processes: import time, first-call and best later time of the
     drop-in, summarised by the median over the processes of ``first / later`` and of the
     import time (one process alone scatters: 1.17-1.92 on fandisk in 8 runs); in one more,
-    the peak resident memory of one call above the input (after a warm-up call on a
-    320-face mesh, so that imports are not counted)."""
+    the peak resident memory of one call above the input (after warm-up calls on three
+    small meshes covering every solver path, so that imports and library code paged in
+    once are not counted)."""
     runs = []
     with tempfile.TemporaryDirectory() as tmp:
         path = os.path.join(tmp, "mesh.npz")
