@@ -355,8 +355,7 @@ class HHJSystem:
         (``subdomain_ldl`` for a QDLDL factor, solved inside the compiled PCG; else
         ``subdomain_solve``), or None when A_SS cannot be factorised (numerically singular
         faces: face-Schwarz alone)."""
-        A = self.csr()[S][:, S].tocsr()
-        A.sum_duplicates()
+        A = self.submatrix(S)
         # QDLDL (CHOLMOD above LDL_MAX): on the sliver subdomains of the --factor-study meshes
         # its factorisation is 2-4x faster than CHOLMOD's and SuperLU's; its factor is solved
         # in the compiled core on the k columns at once (camelhead: 0.05 ms per PCG iteration
@@ -380,6 +379,21 @@ class HHJSystem:
         def solve(r, z):
             z[...] = lu(r)
         return {"subdomain_solve": solve}
+
+    def submatrix(self, S):
+        """``A[S][:, S]`` (scipy CSR, duplicates summed, explicit zeros dropped) for sorted
+        unique internal DOFs ``S``, from the fixed-width rows of S alone: 3 ms for the
+        jittered ellipsoid's 23.7k sliver DOFs against 47 ms through :meth:`csr`."""
+        S = np.asarray(S, dtype=np.int64)
+        local = np.full(self.n, -1, dtype=np.int64)
+        local[S] = np.arange(len(S))
+        cols = local[np.take(self.cols, S, axis=0)]           # (m, 5); -1: outside S
+        vals = np.take(self.A, S, axis=0)
+        keep = (cols >= 0) & (vals != 0)
+        rows = np.broadcast_to(np.arange(len(S))[:, None], cols.shape)
+        B = sp.coo_matrix((vals[keep], (rows[keep], cols[keep])), shape=(len(S), len(S))).tocsr()
+        B.sum_duplicates()
+        return B
 
     def csr(self):
         """The (masked) system matrix in the internal (Morton) numbering, scipy CSR."""

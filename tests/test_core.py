@@ -448,6 +448,28 @@ def _jittered_sliver_system():
     return system, system.sliver_dofs(angle=30.0), -kernels.jump_apply(m, m.V)[system.perm], solvers
 
 
+def test_submatrix_equals_slicing_the_assembled_matrix(saddle):
+    """HHJSystem.submatrix(S) (from the fixed-width rows of S alone) is A[S][:, S] of the
+    assembled CSR, entry for entry, also with fixed (clamped) DOFs."""
+    system, S, _, _ = _jittered_sliver_system()
+    for sys_, dofs in ((system, S), (system, np.arange(system.n)), (system, S[:1])):
+        ref = sys_.csr()[dofs][:, dofs].tocsr()
+        ref.sum_duplicates()
+        ref.eliminate_zeros()
+        got = sys_.submatrix(dofs)
+        assert np.array_equal(got.indptr, ref.indptr) and np.array_equal(got.indices, ref.indices)
+        assert np.array_equal(got.data, ref.data)
+    m = saddle[1]
+    fixed = m.boundary_edges.copy()
+    clamped = HHJSystem(m, fixed)
+    free = np.flatnonzero(~clamped.fixed)
+    ref = clamped.csr()[free][:, free].tocsr()
+    ref.sum_duplicates()
+    ref.eliminate_zeros()
+    got = clamped.submatrix(free)
+    assert np.array_equal(got.toarray(), ref.toarray())
+
+
 def test_native_ldl_subdomain_equals_python_subdomain_solve():
     """The two-level's sliver solve through ``subdomain_ldl`` (QDLDL's factor solved in the
     compiled PCG, k columns at once) gives the iterates of the same factor solved from Python
