@@ -668,8 +668,14 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
                                                     boundary_shape_operator)
     S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver,
                         _check_rtol(rtol), estimated=treatment == "estimate")
-    Sv, N = vertex_shape_operator(mesh, S, smoothing=radius)
+    # = vertex_shape_operator(mesh, S, smoothing=radius), with the (#F, 3, 3) face tensors
+    # freed after the recovery: the smoothing is the call's memory peak
+    X, N, w = _recovery.patch_recover(mesh, S)
+    del S
+    Sv = _recovery.smooth_recovered(mesh, X, N, w, _recovery.smoothing_length(mesh, radius))
+    del X, w
     PD1, PD2, PV1, PV2 = vertex_principal_curvature(mesh, Sv, N)
-    PD1, PD2, PV1, PV2, bad = mark_bad_vertices(mesh, PD1, PD2, PV1, PV2)
+    del Sv
+    PD1, PD2, PV1, PV2, bad = mark_bad_vertices(mesh, PD1, PD2, PV1, PV2, copy=False)
     return (np.ascontiguousarray(PD1), np.ascontiguousarray(PD2),
             np.ascontiguousarray(PV1), np.ascontiguousarray(PV2), bad)

@@ -549,7 +549,7 @@ def validate_mesh(V, F):
     return m.V.copy(), m.F.copy()
 
 
-def mark_bad_vertices(mesh, *arrays):
+def mark_bad_vertices(mesh, *arrays, copy=True):
     """Set the rows of per-vertex outputs without a value to NaN and list them.
 
     A vertex is *bad* when it is unreferenced, has no tangent plane
@@ -562,12 +562,15 @@ def mark_bad_vertices(mesh, *arrays):
     mesh : TriangleMesh
     *arrays : (#V, ...) float arrays
 
+    copy : bool, default True
+        False: float64 arrays are marked in place (the drop-in's own fresh outputs).
+
     Returns
     -------
-    (*arrays, bad) : float64 copies of the arrays with NaN rows, and ``bad``
-        the sorted list of bad vertex indices (``int``).
+    (*arrays, bad) : float64 copies of the arrays (or the arrays, ``copy=False``) with
+        NaN rows, and ``bad`` the sorted list of bad vertex indices (``int``).
     """
-    out = [np.array(a, dtype=np.float64) for a in arrays]
+    out = [np.array(a, dtype=np.float64, copy=copy or None) for a in arrays]
     bad = ~mesh.referenced_vertices | mesh.folded_vertices
     for a in out:
         bad |= ~np.isfinite(a.reshape(len(a), -1)).all(axis=1)

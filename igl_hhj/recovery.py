@@ -35,7 +35,7 @@ from .mesh import TriangleMesh
 
 __all__ = [
     "face_quality", "recovery_weights", "recovery_operator", "vertex_confidence", "QUALITY_FLOOR", "recover_vertex_tensors", "smooth_vertex_tensors",
-    "smoothing_length", "smoothing_matrices", "smoothing_coefficients", "recover_and_smooth", "boundary_band", "BOUNDARY_LENGTH_FACTOR", "SMOOTHING_PER_RADIUS", "SMOOTHING_STEPS", "SMOOTHING_ORDER", "tangent_projection",
+    "smoothing_length", "smoothing_matrices", "smoothing_coefficients", "recover_and_smooth", "patch_recover", "smooth_recovered", "boundary_band", "BOUNDARY_LENGTH_FACTOR", "SMOOTHING_PER_RADIUS", "SMOOTHING_STEPS", "SMOOTHING_ORDER", "tangent_projection",
 ]
 
 # Smoothing length ℓ = SMOOTHING_PER_RADIUS · radius · h̄ (h̄ = mean edge length).
@@ -436,21 +436,43 @@ def recover_and_smooth(mesh: TriangleMesh, S, length, *, weights=None, normals=N
     Sv : (#V, 3, 3) symmetric tangential tensors (NaN rows for unreferenced vertices)
     N : (#V, 3) the normals used
     """
+    X, N, w = patch_recover(mesh, S, weights=weights, normals=normals)
+    return smooth_recovered(mesh, X, N, w, length, steps=steps, order=order, rtol=rtol), N
+
+
+def patch_recover(mesh: TriangleMesh, S, *, weights=None, normals=None):
+    """The compiled patch recovery of :func:`recover_and_smooth` alone.
+
+    Returns
+    -------
+    X : (#V, 6) float64, the recovered tangent-projected tensors (components ``_SYM``)
+    N : (#V, 3) the normals used, w : (#F,) the face weights used
+    """
     from . import kernels
     N = mesh.vertex_normals if normals is None else normals
     w = kernels.recovery_weights(mesh, QUALITY_FLOOR) if weights is None else weights
-    X = kernels.patch_recovery(mesh, S, N, w)            # (#V, 6), tangent-projected
+    return kernels.patch_recovery(mesh, S, N, w), N, w
+
+
+def smooth_recovered(mesh: TriangleMesh, X, N, w, length, *, steps=SMOOTHING_STEPS,
+                     order=SMOOTHING_ORDER, rtol=3e-3):
+    """The compiled smoothing of :func:`recover_and_smooth` on the output of
+    :func:`patch_recover` (``X`` is overwritten): ``(#V, 3, 3)`` tensors, NaN rows at
+    unreferenced vertices.  The face tensors are no longer needed here, so the drop-in
+    frees them before this, its memory peak."""
+    from . import kernels
     if length > 0:
         C, m = smoothing_coefficients(mesh, w)
         status, _ = kernels.smooth_vertex_tensors(mesh, X, C, m, length ** 2 / steps, steps,
                                                   _kernel_coefficients(order), rtol, 500)
-        if status != 0:      # a diffusion solve stalled: the reference's direct fallback
+        del C, m
+        if status != 0:      # a diffusion solve stalled (X unchanged): the reference's direct fallback
             Sv = np.full((mesh.n_vertices, 3, 3), np.nan)
             ref = mesh.referenced_vertices
-            Sv[ref] = _from6(kernels.patch_recovery(mesh, S, N, w)[ref])
+            Sv[ref] = _from6(X[ref])
             return smooth_vertex_tensors(mesh, Sv, N, length, steps=steps, order=order, rtol=rtol,
-                                         weights=w), N
+                                         weights=w)
         kernels.tangent_projection6(mesh, X, N)
     Sv = _from6(X)
     Sv[~mesh.referenced_vertices] = np.nan
-    return Sv, N
+    return Sv

@@ -333,6 +333,22 @@ def test_smoothing_falls_back_to_the_reference_when_a_solve_stalls(closed, monke
     assert rel(fallback, good) <= RTOL
 
 
+def test_stalled_smoothing_kernel_leaves_its_input_unchanged(closed):
+    """The compiled smoothing returns a non-zero status without touching X when a solve
+    does not converge, so the fallback restarts from the recovered tensors (the drop-in
+    has freed the face tensors by then)."""
+    from igl_hhj import recovery as rc
+    S = _shape_operator(closed, None, None, None, "direct")
+    X, N, w = rc.patch_recover(closed, S)
+    X0 = X.copy()
+    C, m = rc.smoothing_coefficients(closed, w)
+    t = rc.smoothing_length(closed, 5) ** 2 / 2
+    status, its = kernels.smooth_vertex_tensors(closed, X, C, m, t, 2, [2.0, -1.0], 1e-14, 2)
+    assert status != 0 and np.array_equal(X, X0)
+    status, _ = kernels.smooth_vertex_tensors(closed, X, C, m, t, 2, [2.0, -1.0], 3e-3, 500)
+    assert status == 0 and not np.array_equal(X, X0)
+
+
 def test_fused_jacobi_pcg_equals_csr_preconditioner(closed):
     """Jacobi is fused into the PCG sweeps (no z vector); the same preconditioner as an
     explicit diagonal CSR matrix runs the unfused code path: the bits must agree."""
@@ -645,3 +661,34 @@ def test_large_call_heap_does_not_change_results(monkeypatch):
         np.testing.assert_array_equal(a, b)
     assert ref[4] == out[4]
     np.testing.assert_array_equal(S_ref, igl_hhj.shape_operator(V, F))
+
+
+def test_dropin_frees_the_face_tensors_before_its_memory_peak(monkeypatch):
+    """The drop-in frees the (#F, 3, 3) face tensors after the patch recovery, before the
+    smoothing (its memory peak), and gives the same values as the public composition."""
+    import weakref
+
+    from igl_hhj import curvature, recovery
+    V, F = icosphere(4)
+    V = jitter_tangentially(V, F, Sphere(), 0.3, seed=1)
+    alive = {}
+    real_S, real_smooth = curvature._shape_operator, recovery.smooth_recovered
+
+    def shape_operator(*a, **k):
+        S = real_S(*a, **k)
+        alive["S"] = weakref.ref(S)
+        return S
+
+    def smooth(*a, **k):
+        alive["at smoothing"] = alive["S"]() is not None
+        return real_smooth(*a, **k)
+    monkeypatch.setattr(curvature, "_shape_operator", shape_operator)
+    monkeypatch.setattr(recovery, "smooth_recovered", smooth)
+    out = igl_hhj.principal_curvature(V, F)
+    assert alive["at smoothing"] is False
+    monkeypatch.undo()
+    m = TriangleMesh(V, F)
+    Sv, N = curvature.vertex_shape_operator(m, igl_hhj.shape_operator(m), smoothing=5)
+    ref = igl_hhj.mesh.mark_bad_vertices(m, *curvature.vertex_principal_curvature(m, Sv, N))
+    for a, b in zip(ref, out):
+        np.testing.assert_array_equal(a, b)

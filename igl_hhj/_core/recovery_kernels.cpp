@@ -228,38 +228,39 @@ void vertex_laplacian(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* EL
 // (M + t L) dY = -t L Y_prev, Jacobi block PCG to rtol (maxiter iterations), as
 // recovery.smooth_vertex_tensors.  m (#V,) the lumped mass (floored), binom the
 // coefficients binom(order, j) (-1)^(j+1), j = 1..order.  Returns 0, or the PCG
-// status of the first solve that did not converge (X is then unspecified).
+// status of the first solve that did not converge (X is then left unchanged).
 int smooth_vertex_tensors(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* ELI, const double* C,
                           const double* m, double t, int steps, const std::vector<double>& binom,
                           double rtol, i64 maxiter, double* X, int nt, i64* iterations) {
     std::vector<i64> indptr, diag_pos;
     std::vector<std::int32_t> indices;
-    std::vector<double> L;
-    vertex_laplacian(nV, E, nE, EF, ELI, C, indptr, indices, L, diag_pos);
-    std::vector<double> A(L.size()), dinv(nV);
-    for (size_t q = 0; q < L.size(); ++q) A[q] = t * L[q];
+    std::vector<double> A;
+    vertex_laplacian(nV, E, nE, EF, ELI, C, indptr, indices, A, diag_pos);
+    // A = M + t L in place (L itself is not kept: -t L Y = M Y - A Y below)
+    std::vector<double> dinv(nV);
+    for (size_t q = 0; q < A.size(); ++q) A[q] *= t;
     for (i64 v = 0; v < nV; ++v) {
         A[diag_pos[v]] += m[v];
         dinv[v] = 1.0 / A[diag_pos[v]];
     }
     const size_t n6 = (size_t)nV * 6;
-    std::vector<double> Y(X, X + n6), R(n6), dY(n6);
-    std::fill(X, X + n6, 0.0);
+    // X is read-only until every solve has converged (a caller's fallback restarts from it)
+    std::vector<double> Y(X, X + n6), R(n6), dY(n6), acc6(n6, 0.0);
     *iterations = 0;
     for (size_t j = 0; j < binom.size(); ++j) {
         for (int s = 0; s < steps; ++s) {
-            // R = -t L Y
+            // R = -t L Y = M Y - A Y
 #ifdef IGL_HHJ_OPENMP
 #pragma omp parallel for schedule(static) num_threads(nt)
 #endif
             for (i64 v = 0; v < nV; ++v) {
                 double acc[6] = {0, 0, 0, 0, 0, 0};
                 for (i64 q = indptr[v]; q < indptr[v + 1]; ++q) {
-                    const double a = L[q];
+                    const double a = A[q];
                     const double* y = &Y[6 * (size_t)indices[q]];
                     for (int c = 0; c < 6; ++c) acc[c] += a * y[c];
                 }
-                for (int c = 0; c < 6; ++c) R[6 * v + c] = -t * acc[c];
+                for (int c = 0; c < 6; ++c) R[6 * v + c] = m[v] * Y[6 * v + c] - acc[c];
             }
             PCGResult res = block_pcg(nV, 6, indptr.data(), indices.data(), A.data(), nullptr, nullptr,
                                       nullptr, dinv.data(), R.data(), dY.data(), rtol, maxiter, 0,
@@ -268,8 +269,9 @@ int smooth_vertex_tensors(i64 nV, const i64* E, i64 nE, const i64* EF, const i64
             if (res.status != 0) return res.status;
             for (size_t q = 0; q < n6; ++q) Y[q] += std::isfinite(dY[q]) ? dY[q] : 0.0;
         }
-        for (size_t q = 0; q < n6; ++q) X[q] += binom[j] * Y[q];
+        for (size_t q = 0; q < n6; ++q) acc6[q] += binom[j] * Y[q];
     }
+    std::copy(acc6.begin(), acc6.end(), X);
     return 0;
 }
 
