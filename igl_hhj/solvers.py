@@ -171,6 +171,16 @@ def _cholmod(A):
     return solve
 
 
+def _canonical_csr(A):
+    """``A`` as scipy CSR with sorted indices and summed duplicates; a copy when that
+    needs changing (``sum_duplicates`` works in place: the caller's matrix is left alone)."""
+    A = sp.csr_matrix(A)
+    if not A.has_canonical_format:
+        A = A.copy()
+        A.sum_duplicates()
+    return A
+
+
 def factorize(A, *, prefer_lu=False):
     """One sparse factorisation of a symmetric positive (semi-)definite A: a ``solve(R)`` callable.
 
@@ -178,10 +188,7 @@ def factorize(A, *, prefer_lu=False):
     (SuperLU) when ``prefer_lu`` is set (matrices known to be numerically semi-definite,
     e.g. with faces of relative area ~1e-9) or when the first choice fails.
     ``R`` (n,) or (n, k) float64."""
-    A = sp.csr_matrix(A)
-    if not A.has_canonical_format:
-        A = A.copy()          # sum_duplicates works in place: leave the caller's matrix alone
-        A.sum_duplicates()
+    A = _canonical_csr(A)
     if not prefer_lu:
         fn = _ldl(A) if A.shape[0] <= LDL_MAX else _cholmod(A)
         if fn is not None:
@@ -207,10 +214,7 @@ def cholesky_solve(A, R):
     n = A.shape[0]
     if n == 0:
         return np.zeros_like(R)
-    A = sp.csr_matrix(A)
-    if not A.has_canonical_format:
-        A = A.copy()
-        A.sum_duplicates()
+    A = _canonical_csr(A)
     X = factorize(A)(R)
     R2 = R.reshape(n, -1)
     res = np.linalg.norm((A @ X.reshape(n, -1)) - R2, axis=0)
@@ -238,10 +242,7 @@ def mass_solver(M, lumped_inv, rtol=1e-13):
     lumped_inv : (n,) float64, ``1 / rowsum(M)``
     rtol : float, relative residual per column
     """
-    M = sp.csr_matrix(M)
-    if not M.has_canonical_format:
-        M = M.copy()
-        M.sum_duplicates()
+    M = _canonical_csr(M)
     fallback = []
 
     def solve(b):

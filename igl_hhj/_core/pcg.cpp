@@ -264,7 +264,7 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
 
 void ldl_schedule(LDLFactor& f) {
     const i64 n = f.n;
-    std::vector<i64> root(n), work;
+    std::vector<i64> root(n);
     std::vector<i64> parent(n, -1);
     for (i64 j = 0; j < n; ++j)
         for (i64 q = f.Lp[j]; q < f.Lp[j + 1]; ++q)
