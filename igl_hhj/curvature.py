@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import kernels
+from . import intrinsic as _intrinsic
 from . import recovery as _recovery
 from .boundary_estimation import BOUNDARY_TREATMENTS, estimate_boundary_normals
 from .hhj import HHJProjection, clamped_load
@@ -547,22 +548,23 @@ def vertex_principal_curvature(mesh, Sv, N):
     return PD1, PD2, PV1, PV2
 
 
-def vertex_shape_operator(mesh, S, *, smoothing=0, recovery="patch"):
+def vertex_shape_operator(mesh, S, *, smoothing=0, recovery="intrinsic"):
     """Recover per-vertex tensors from face tensors, optionally smoothed.
 
-    1. Recovery (:func:`igl_hhj.recovery.recover_vertex_tensors`): by default
-       a weighted least-squares *linear* fit of the incident face tensors in the
-       vertex tangent frame evaluated at the vertex ("patch", exact for linear
-       fields, so irregular 1-rings do not bias it); "lumped" is the weighted
-       average ``Σ_T w_T S_T / Σ_T w_T``; "consistent" the consistent-mass L2
-       projection onto P1.  Face weights ``w_T = |T| q_T`` (area × shape
-       quality) keep slivers from poisoning their neighbours.  Each value is
-       projected onto the vertex tangent plane, ``P_v S_v P_v`` with
-       ``P_v = I - N_v ⊗ N_v``, N_v the area-weighted vertex normal
-       (``igl.per_vertex_normals``).
-    2. Smoothing (``smoothing > 0``, units of ``radius`` in
-       :func:`principal_curvature`): :func:`igl_hhj.recovery.smooth_vertex_tensors`
-       at length ``ℓ = SMOOTHING_PER_RADIUS · smoothing · h̄``.
+    ``recovery="intrinsic"`` (default, the drop-in's vertex stage,
+    :mod:`igl_hhj.intrinsic`): every face tensor is carried into the tangent plane
+    of its vertices by the minimal rotation ν_T → N_v, fitted there by a weighted
+    linear least-squares patch fit, and (``smoothing > 0``) smoothed by the twiced
+    implicit diffusion of its trace (scalar cotangent Laplacian) and its deviator
+    (spin-2 connection Laplacian) at the per-face length
+    ``ℓ_T = SMOOTHING_PER_RADIUS · smoothing · h_T``.
+
+    The ambient variants average the 3×3 tensors of the incident faces and project
+    the result onto the vertex plane (biased where the normal turns fast, e.g. thin
+    tubes; kept for comparison): "patch" (linear fit), "lumped" (weighted average)
+    and "consistent" (consistent-mass L2 projection), each followed for
+    ``smoothing > 0`` by :func:`igl_hhj.recovery.smooth_vertex_tensors` at the
+    global length ``ℓ = SMOOTHING_PER_RADIUS · smoothing · h̄``.
 
     Returns
     -------
@@ -570,6 +572,11 @@ def vertex_shape_operator(mesh, S, *, smoothing=0, recovery="patch"):
     N : (#V, 3) vertex normals used
     """
     _check_smoothing(smoothing, "smoothing")
+    if recovery == "intrinsic":
+        X, N = _intrinsic.vertex_stage(mesh, S, smoothing)
+        Sv = _intrinsic.to_tensors(X, N)
+        Sv[~mesh.referenced_vertices] = np.nan
+        return Sv, N
     if recovery == "patch":       # compiled (reference: _vertex_shape_operator_numpy)
         length = _recovery.smoothing_length(mesh, smoothing) if smoothing > 0 else 0.0
         return _recovery.recover_and_smooth(mesh, S, length)
@@ -666,16 +673,17 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
     mesh = as_mesh(V, F)
     boundary_normals, treatment = _resolve_boundary(mesh, boundary, boundary_normals,
                                                     boundary_shape_operator)
+    rtol = _check_rtol(rtol)
     S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver,
-                        _check_rtol(rtol), estimated=treatment == "estimate")
-    # = vertex_shape_operator(mesh, S, smoothing=radius), with the (#F, 3, 3) face tensors
-    # freed after the recovery: the smoothing is the call's memory peak
-    X, N, w = _recovery.patch_recover(mesh, S)
+                        rtol, estimated=treatment == "estimate")
+    X, N = _intrinsic.vertex_stage(mesh, S, radius, rtol=rtol)
     del S
-    Sv = _recovery.smooth_recovered(mesh, X, N, w, _recovery.smoothing_length(mesh, radius))
-    del X, w
-    PD1, PD2, PV1, PV2 = vertex_principal_curvature(mesh, Sv, N)
-    del Sv
+    PD1, PD2, PV1, PV2 = _intrinsic.principal(X, N)
+    del X
+    ref = mesh.referenced_vertices
+    if not ref.all():
+        for A in (PD1, PD2, PV1, PV2):
+            A[~ref] = np.nan
     PD1, PD2, PV1, PV2, bad = mark_bad_vertices(mesh, PD1, PD2, PV1, PV2, copy=False)
     return (np.ascontiguousarray(PD1), np.ascontiguousarray(PD2),
             np.ascontiguousarray(PV1), np.ascontiguousarray(PV2), bad)

@@ -40,6 +40,7 @@ __all__ = [
     "face_tensors", "lumped_vertex_recovery", "principal_2x2", "max_threads",
     "set_num_threads", "ell_indptr", "edge_morton_order", "recovery_weights", "patch_recovery",
     "tangent_projection6", "smooth_vertex_tensors", "face_metrics", "vertex_area_sums",
+    "intrinsic_patch_recovery", "connection_smoothing",
     "large_call_heap", "with_large_call_heap", "LARGE_CALL_HEAP",
 ]
 
@@ -422,3 +423,39 @@ def smooth_vertex_tensors(mesh, X, C, mass, t, steps, coefficients, rtol, maxite
     return _core.smooth_vertex_tensors(_i64(mesh.edges), _i64(mesh.edge_faces), _i64(mesh.edge_local_index),
                                        C, mass, X, float(t), int(steps), [float(c) for c in coefficients],
                                        float(rtol), int(maxiter))
+
+
+def intrinsic_patch_recovery(mesh, S, N, w):
+    """Intrinsic patch recovery (#V, 3) components ``(h, Re z, Im z)``; reference
+    :func:`igl_hhj.intrinsic.recover`.  ``S`` (#F, 3, 3), ``N`` (#V, 3) unit vertex
+    normals, ``w`` (#F,) face weights (rows of unreferenced vertices 0)."""
+    S = _f64(S, "S", (3, 3))
+    N = _f64(N, "N", (3,))
+    w = _f64(w, "w")
+    if S.shape[0] != mesh.n_faces or N.shape[0] != mesh.n_vertices or w.shape != (mesh.n_faces,):
+        raise ValueError("intrinsic_patch_recovery: S must be (#F, 3, 3), N (#V, 3) and w (#F,)")
+    _threads()
+    return _core.intrinsic_patch_recovery(mesh.V, mesh.F, S, N, w, _ref_mask(mesh),
+                                          float(mesh.mean_edge_length))
+
+
+def connection_smoothing(mesh, X, C, mass, phase, steps, coefficients, rtol, maxiter):
+    """Twiced implicit diffusion of the components ``X`` (#V, 3) = (h, Re z, Im z), in place.
+
+    Reference: :func:`igl_hhj.intrinsic.smooth`.  ``C`` (#F, 3) per-face stiffness entries
+    (times the per-face diffusion time), ``mass`` (#V,) the floored lumped mass,
+    ``phase`` (#E, 2) cos and sin of the spin-2 transport of each edge, ``coefficients``
+    binom(order, j)(-1)^(j+1).  Returns ``(status, iterations, components)``; status 0
+    when every PCG solve converged (else X is unchanged)."""
+    if not (isinstance(X, np.ndarray) and X.dtype == np.float64 and X.flags.c_contiguous
+            and X.shape == (mesh.n_vertices, 3)):
+        raise ValueError("connection_smoothing: X must be a C-contiguous float64 (#V, 3) array")
+    C = _f64(C, "C", (3,))
+    mass = _f64(mass, "mass")
+    phase = _f64(phase, "phase", (2,))
+    if C.shape[0] != mesh.n_faces or mass.shape != (mesh.n_vertices,) or phase.shape[0] != mesh.n_edges:
+        raise ValueError("connection_smoothing: C must be (#F, 3), mass (#V,) and phase (#E, 2)")
+    _threads()
+    return _core.connection_smoothing(_i64(mesh.edges), _i64(mesh.edge_faces), _i64(mesh.edge_local_index),
+                                      C, mass, phase, X, int(steps), [float(c) for c in coefficients],
+                                      float(rtol), int(maxiter))

@@ -207,7 +207,7 @@ def _bincount(idx, w, n):
     return np.bincount(idx, weights=w, minlength=n)
 
 
-def recovery_operator(mesh: TriangleMesh, method="patch", weights=None, normals=None):
+def recovery_operator(mesh: TriangleMesh, method="patch", weights=None, normals=None, corners=False):
     """The sparse (#V × #F) matrix R of the lumped or patch recovery: ``S_v = (R S_T)_v``.
 
     "lumped": ``R[v, T] = w_T / Σ_{T'∋v} w_T'``.  "patch": the weighted
@@ -218,13 +218,16 @@ def recovery_operator(mesh: TriangleMesh, method="patch", weights=None, normals=
     for fields linear on the patch, so irregular 1-rings do not bias it.
     Vertices whose linear part is ill-conditioned (boundary corners, one or
     two faces) keep the lumped row.  Rows of unreferenced vertices are empty.
+    ``weights`` may also be per corner, (#F, 3); ``corners=True`` returns the
+    (#V × 3#F) matrix acting on per-corner values (row-major corners ``3 f + c``), as
+    :func:`igl_hhj.intrinsic.recover` needs.
     """
     N = mesh.vertex_normals if normals is None else normals
     w = recovery_weights(mesh) if weights is None else np.asarray(weights, dtype=np.float64)
     F = mesh.F
     nV, nF = mesh.n_vertices, mesh.n_faces
     idx = F.ravel()
-    W = np.repeat(w, 3)
+    W = w.ravel() if w.ndim == 2 else np.repeat(w, 3)   # per-corner (#F, 3) or per-face (#F,)
     s0 = _bincount(idx, W, nV)
     ref = mesh.referenced_vertices
     lost = ref & ~(s0 > 0)            # all incident faces weightless: plain average
@@ -270,6 +273,8 @@ def recovery_operator(mesh: TriangleMesh, method="patch", weights=None, normals=
     elif method != "lumped":
         raise ValueError(f"unknown recovery method {method!r}; use 'patch', 'lumped' or 'consistent'")
     k = np.where(np.isfinite(k), k, 0.0)
+    if corners:
+        return sp.csr_matrix((k, (idx, np.arange(3 * nF))), shape=(nV, 3 * nF))
     cols = np.repeat(np.arange(nF), 3)
     return sp.csr_matrix((k, (idx, cols)), shape=(nV, nF))
 

@@ -369,4 +369,45 @@ NB_MODULE(_hhj_core, m) {
         }
         return nb::make_tuple(status, iterations);
     });
+
+    m.def("intrinsic_patch_recovery", [](In<double> V, In<i64> F, In<double> S, In<double> N, In<double> w,
+                                         In<unsigned char> ref, double h) {
+        const i64 nF = F.shape(0), nV = V.shape(0);
+        need(S.shape(0) == (size_t)nF && N.shape(0) == (size_t)nV && w.shape(0) == (size_t)nF &&
+             ref.shape(0) == (size_t)nV, "intrinsic_patch_recovery: shapes");
+        std::vector<double> X((size_t)nV * 3);
+        {
+            nb::gil_scoped_release nogil;
+            hhj::ThreadBudget tb(nF);
+            hhj::intrinsic_patch_recovery(V.data(), F.data(), nF, nV, S.data(), N.data(), w.data(), ref.data(),
+                                          h, X.data(), tb.nt);
+        }
+        return to_numpy(std::move(X), {(size_t)nV, 3});
+    });
+
+    m.def("connection_smoothing", [](In<i64> E, In<i64> EF, In<i64> ELI, In<double> C, In<double> mass,
+                                     In<double> phase, nb::ndarray<double, nb::c_contig, nb::device::cpu> X,
+                                     int steps, std::vector<double> binom, double rtol, i64 maxiter) {
+        const i64 nV = X.shape(0), nE = E.shape(0);
+        need(X.ndim() == 2 && X.shape(1) == 3 && mass.shape(0) == (size_t)nV, "connection_smoothing: X, mass");
+        need(EF.shape(0) == (size_t)nE && ELI.shape(0) == (size_t)nE && C.ndim() == 2 && C.shape(1) == 3 &&
+             phase.ndim() == 2 && phase.shape(0) == (size_t)nE && phase.shape(1) == 2,
+             "connection_smoothing: topology shapes");
+        need(nV < ((i64)1 << 31), "connection_smoothing: at most 2**31 - 1 vertices");
+        const i64 nF = C.shape(0);
+        const i64* e = E.data();
+        for (i64 q = 0; q < 2 * nE; ++q) need(e[q] >= 0 && e[q] < nV, "connection_smoothing: edge index out of range");
+        for (i64 q = 0; q < 2 * nE; ++q)
+            need(EF.data()[q] < nF && ELI.data()[q] < 3, "connection_smoothing: edge_faces out of range");
+        int status;
+        i64 iterations = 0, ngroups = 0;
+        {
+            nb::gil_scoped_release nogil;
+            hhj::ThreadBudget tb(nV);
+            status = hhj::connection_smoothing(nV, E.data(), nE, EF.data(), ELI.data(), C.data(), mass.data(),
+                                               phase.data(), steps, binom, rtol, maxiter, X.data(), tb.nt,
+                                               &iterations, &ngroups);
+        }
+        return nb::make_tuple(status, iterations, ngroups);
+    });
 }

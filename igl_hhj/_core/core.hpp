@@ -83,6 +83,19 @@ inline void tangent_frame(const double* n, double e1[3], double e2[3]) {
     cross3(n, e1, e2);
 }
 
+// out = R x, R the minimal rotation taking unit a to unit b (Rodrigues:
+// R x = c x + k x x + (k.x) k / (1 + c), k = a x b, c = a.b; intrinsic.transport).
+// Returns c; undefined for c = -1 (callers give such pairs no weight).
+inline double min_rotation(const double* x, const double* a, const double* b, double out[3]) {
+    double k[3], kx[3];
+    cross3(a, b, k);
+    cross3(k, x, kx);
+    const double c = dot3(a, b);
+    const double s = dot3(k, x) / (1.0 + c);
+    for (int p = 0; p < 3; ++p) out[p] = c * x[p] + kx[p] + s * k[p];
+    return c;
+}
+
 // out = P S P, P = I - n n^T (projection of a 3x3 tensor onto the tangent plane of unit n)
 inline void project_tangent(const double* n, const double S[3][3], double out[3][3]) {
     double P[3][3], T[3][3];
@@ -153,6 +166,18 @@ void patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double*
                     const double* w, const unsigned char* ref, double h, double* X);
 void tangent_projection6(double* X, const double* N, const unsigned char* ref, i64 n, bool keep_trace,
                          int nt);
+void intrinsic_patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S,
+                              const double* N, const double* w, const unsigned char* ref, double h,
+                              double* X, int nt);
+void vertex_laplacian(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* ELI, const double* C,
+                      std::vector<i64>& indptr, std::vector<std::int32_t>& indices,
+                      std::vector<double>& L, std::vector<i64>& diag_pos,
+                      std::vector<i64>* pos_lo = nullptr, std::vector<i64>* pos_hi = nullptr);
+
+// intrinsic_kernels.cpp
+int connection_smoothing(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* ELI, const double* C,
+                         const double* m, const double* phase, int steps, const std::vector<double>& binom,
+                         double rtol, i64 maxiter, double* X, int nt, i64* iterations, i64* ngroups);
 int smooth_vertex_tensors(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* ELI, const double* C,
                           const double* m, double t, int steps, const std::vector<double>& binom,
                           double rtol, i64 maxiter, double* X, int nt, i64* iterations);

@@ -71,18 +71,20 @@ void recovery_weights(const double* V, const i64* F, i64 nF, const i64* FE, cons
     }
 }
 
-// patch_recovery: X[v] (6 components) = sum_{T ∋ v} k_{v,T} S_T, the rows of
-// recovery.recovery_operator("patch"): k = w_T (g0 + g1 u_T + g2 v_T) / det, the
-// weighted least-squares fit of a + b u + c v to the face values at the centroid
-// offsets (u_T, v_T) / h in v's tangent frame, evaluated at the vertex; the lumped
-// weight w_T / sum w where the linear part is ill-conditioned.  S (#F,9), N (#V,3)
-// (non-finite entries count as 0), w (#F,), ref (#V,) referenced flags, h the mean
-// edge length; X (#V,6), rows of unreferenced vertices 0.
-void patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S, const double* N,
-                    const double* w, const unsigned char* ref, double h, double* X) {
+// The weighted least-squares linear patch fit shared by patch_recovery and
+// intrinsic_patch_recovery (recovery.recovery_operator("patch")): for every corner
+// (f, c) of vertex v the coefficient k_{v,(f,c)} = W (g0 + g1 u + g2 v) / det of the fit
+// of a + b u + c v to the corner values at the centroid offsets (u, v) / h in v's
+// tangent frame, evaluated at the vertex; the lumped weight W / sum W where the linear
+// part is ill-conditioned.  cw(f, c) the corner weight (vertices whose corners all
+// weigh 0 get weight 1 on each), emit(f, c, v, k) receives every coefficient, in face
+// order (serial: deterministic).  N (#V,3) (non-finite entries count as 0), ref (#V,).
+template <class CornerWeight, class Emit>
+void patch_fit(const double* V, const i64* F, i64 nF, i64 nV, const double* N, const unsigned char* ref,
+               double h, CornerWeight cw, Emit emit) {
     std::vector<double> s0(nV, 0.0);
     for (i64 f = 0; f < nF; ++f)
-        for (int c = 0; c < 3; ++c) s0[F[3 * f + c]] += w[f];
+        for (int c = 0; c < 3; ++c) s0[F[3 * f + c]] += cw(f, c);
     // vertices whose faces all have weight 0: plain average (weight 1 per face)
     std::vector<unsigned char> lost(nV, 0);
     bool any_lost = false;
@@ -90,14 +92,13 @@ void patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double*
         lost[v] = ref[v] && !(s0[v] > 0);
         any_lost = any_lost || lost[v];
     }
-    auto corner_weight = [&](i64 f, i64 v) { return lost[v] ? 1.0 : w[f]; };
+    auto corner_weight = [&](i64 f, int c) { return lost[F[3 * f + c]] ? 1.0 : cw(f, c); };
     double wmax = 0.0;
     if (any_lost) std::fill(s0.begin(), s0.end(), 0.0);
     for (i64 f = 0; f < nF; ++f)
         for (int c = 0; c < 3; ++c) {
-            const i64 v = F[3 * f + c];
-            const double W = corner_weight(f, v);
-            if (any_lost) s0[v] += W;
+            const double W = corner_weight(f, c);
+            if (any_lost) s0[F[3 * f + c]] += W;
             wmax = std::max(wmax, W);
         }
     wmax = std::max(wmax, std::numeric_limits<double>::min());
@@ -125,7 +126,7 @@ void patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double*
             const i64 v = F[3 * f + c];
             double u, t;
             offsets(f, v, u, t);
-            const double W = corner_weight(f, v) / wmax;
+            const double W = corner_weight(f, c) / wmax;
             double* m = &mom[6 * v];
             m[0] += W; m[1] += W * u; m[2] += W * t;
             m[3] += W * u * u; m[4] += W * u * t; m[5] += W * t * t;
@@ -145,7 +146,6 @@ void patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double*
                   (tr > 0.05 * (d + ff) / a) && std::isfinite(det) && det != 0.0;
         g[3 * v] = g0 / det; g[3 * v + 1] = g1 / det; g[3 * v + 2] = g2 / det;
     }
-    std::fill(X, X + (size_t)nV * 6, 0.0);
     for (i64 f = 0; f < nF; ++f)
         for (int c = 0; c < 3; ++c) {
             const i64 v = F[3 * f + c];
@@ -153,15 +153,73 @@ void patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double*
             if (good[v]) {
                 double u, t;
                 offsets(f, v, u, t);
-                const double W = corner_weight(f, v) / wmax;
+                const double W = corner_weight(f, c) / wmax;
                 k = W * (g[3 * v] + g[3 * v + 1] * u + g[3 * v + 2] * t);
             } else {
-                k = corner_weight(f, v) / s0[v];
+                k = corner_weight(f, c) / s0[v];
             }
             if (!std::isfinite(k)) k = 0.0;
-            const double* Sf = S + 9 * f;
-            for (int s = 0; s < 6; ++s) X[6 * v + s] += k * Sf[3 * SYM[s][0] + SYM[s][1]];
+            emit(f, c, v, k);
         }
+}
+
+// patch_recovery: X[v] (6 components) = sum_{T ∋ v} k_{v,T} S_T (patch_fit with the face
+// weights w).  S (#F,9), w (#F,), h the mean edge length; X (#V,6), rows of
+// unreferenced vertices 0.
+void patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S, const double* N,
+                    const double* w, const unsigned char* ref, double h, double* X) {
+    std::fill(X, X + (size_t)nV * 6, 0.0);
+    patch_fit(V, F, nF, nV, N, ref, h, [&](i64 f, int) { return w[f]; },
+              [&](i64 f, int, i64 v, double k) {
+                  const double* Sf = S + 9 * f;
+                  for (int s = 0; s < 6; ++s) X[6 * v + s] += k * Sf[3 * SYM[s][0] + SYM[s][1]];
+              });
+}
+
+// intrinsic_patch_recovery (intrinsic.recover): the corner components (h, Re z, Im z) of
+// R S_T R^T in the frame of v, R the minimal rotation nu_T -> N_v (corner weight w_T
+// where nu_T . N_v > 0, else 0), fitted by patch_fit.  X (#V,3), rows of unreferenced 0.
+void intrinsic_patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S,
+                              const double* N, const double* w, const unsigned char* ref, double h,
+                              double* X, int nt) {
+    // corner components and cosines, one pass over faces (parallel: no scatter)
+    std::vector<double> Y((size_t)nF * 9), cosine((size_t)nF * 3);
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+    for (i64 f = 0; f < nF; ++f) {
+        double c[3];
+        face_cross(V, F, f, c);
+        const double nc = std::sqrt(dot3(c, c));
+        const double nu[3] = {c[0] / nc, c[1] / nc, c[2] / nc};
+        const double* Sf = S + 9 * f;
+        for (int k = 0; k < 3; ++k) {
+            const i64 v = F[3 * f + k];
+            double n[3], e1[3], e2[3];
+            const bool fin = std::isfinite(N[3 * v]) && std::isfinite(N[3 * v + 1]) && std::isfinite(N[3 * v + 2]);
+            for (int a = 0; a < 3; ++a) n[a] = fin ? N[3 * v + a] : (a == 2 ? 1.0 : 0.0);
+            tangent_frame(n, e1, e2);
+            double f1[3], f2[3];
+            const double cs = min_rotation(e1, n, nu, f1);
+            min_rotation(e2, n, nu, f2);
+            double Sf1[3], Sf2[3];
+            for (int p = 0; p < 3; ++p) {
+                Sf1[p] = Sf[3 * p] * f1[0] + Sf[3 * p + 1] * f1[1] + Sf[3 * p + 2] * f1[2];
+                Sf2[p] = Sf[3 * p] * f2[0] + Sf[3 * p + 1] * f2[1] + Sf[3 * p + 2] * f2[2];
+            }
+            const double a = dot3(f1, Sf1), d = dot3(f2, Sf2), b = dot3(f1, Sf2);
+            double* y = &Y[9 * f + 3 * k];
+            y[0] = 0.5 * (a + d); y[1] = 0.5 * (a - d); y[2] = b;
+            for (int q = 0; q < 3; ++q) if (!std::isfinite(y[q])) y[q] = 0.0;
+            cosine[3 * f + k] = cs;
+        }
+    }
+    std::fill(X, X + (size_t)nV * 3, 0.0);
+    patch_fit(V, F, nF, nV, N, ref, h, [&](i64 f, int c) { return cosine[3 * f + c] > 0 ? w[f] : 0.0; },
+              [&](i64 f, int c, i64 v, double k) {
+                  const double* y = &Y[9 * f + 3 * c];
+                  for (int q = 0; q < 3; ++q) X[3 * v + q] += k * y[q];
+              });
 }
 
 // tangent_projection6: X[r] <- P S P (symmetrised) + keep_trace * (N^T S N) P / 2,
@@ -196,7 +254,8 @@ void tangent_projection6(double* X, const double* N, const unsigned char* ref, i
 // stiffness entry of the edge opposite corner i, recovery.smoothing_matrices).
 void vertex_laplacian(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* ELI, const double* C,
                       std::vector<i64>& indptr, std::vector<std::int32_t>& indices,
-                      std::vector<double>& L, std::vector<i64>& diag_pos) {
+                      std::vector<double>& L, std::vector<i64>& diag_pos,
+                      std::vector<i64>* pos_lo_out, std::vector<i64>* pos_hi_out) {
     indptr.assign(nV + 1, 0);
     for (i64 e = 0; e < nE; ++e) { ++indptr[E[2 * e] + 1]; ++indptr[E[2 * e + 1] + 1]; }
     for (i64 v = 0; v < nV; ++v) indptr[v + 1] += indptr[v] + 1;   // + 1: the diagonal
@@ -221,6 +280,8 @@ void vertex_laplacian(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* EL
         L[diag_pos[E[2 * e]]] += we;
         L[diag_pos[E[2 * e + 1]]] += we;
     }
+    if (pos_lo_out) *pos_lo_out = std::move(pos_lo);
+    if (pos_hi_out) *pos_hi_out = std::move(pos_hi);
 }
 
 // smooth_vertex_tensors: (I - (I - G)^order) X on the 6 columns of X (#V,6), in place,
