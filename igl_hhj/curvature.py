@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import kernels
+from . import components as _components
 from . import intrinsic as _intrinsic
 from . import recovery as _recovery
 from .boundary_estimation import BOUNDARY_TREATMENTS, estimate_boundary_normals
@@ -195,8 +196,31 @@ def _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supp
                     rtol=DEFAULT_RTOL, info=None, estimated=False):
     """Compiled path of :func:`shape_operator` (reference: :func:`_shape_operator_reference`).
 
+    A mesh with several connected components is solved in independent groups
+    (:func:`igl_hhj.components.solve_groups`): no component depends on another.
     ``estimated``: ``boundary_normals`` come from :func:`estimate_boundary_normals`
     (see :func:`_boundary_partition`)."""
+    data = (boundary_normals, boundary_shape_operator, simply_supported)
+    groups = None
+    if all(d is None or np.shape(d)[:1] == (mesh.n_vertices,) for d in data):
+        groups = _components.solve_groups(mesh, solver)
+    if groups is None:
+        return _shape_operator_one(mesh, *data, solver, rtol, info, estimated)
+    S = np.empty((mesh.n_faces, 3, 3))
+    for faces, group_solver in groups:
+        sub, verts = _components.submesh(mesh, faces)
+        sub_data = [None if d is None else np.asarray(d)[verts] for d in data]
+        sub_info = {} if info is not None else None
+        S[faces] = _shape_operator_one(sub, *sub_data, group_solver, rtol, sub_info, estimated)
+        if info is not None:
+            info["iterations"] = max(info.get("iterations", 0), sub_info.get("iterations", 0))
+            info.setdefault("solver", sub_info.get("solver"))
+    return S
+
+
+def _shape_operator_one(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver,
+                        rtol=DEFAULT_RTOL, info=None, estimated=False):
+    """:func:`_shape_operator` on one solve group (the whole mesh, or a group of components)."""
     clamped, ss_edges = _boundary_partition(mesh, boundary_normals, boundary_shape_operator,
                                             simply_supported, estimated)
     N = _normalised_boundary_normals(mesh, boundary_normals, clamped) if clamped.any() else None
@@ -210,7 +234,8 @@ def _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supp
     if fixed is not None:                                     # eq. 5.18/5.19: move ρ to the load
         rhs -= system.fixed_coupling(rho)
         rhs[fixed] = 0.0
-    s, solve_info = system.solve(rhs, solver, rtol, overwrite_rhs=True)   # (#E, 3): σ^k DOFs
+    # coupled: one CG recurrence on the 3 coordinates, so a rotation of V rotates s exactly
+    s, solve_info = system.solve(rhs, solver, rtol, overwrite_rhs=True, coupled=True)   # (#E, 3): σ^k DOFs
     del rhs
     if fixed is not None:
         s[fixed] = rho[fixed]

@@ -40,7 +40,7 @@ __all__ = [
     "face_tensors", "lumped_vertex_recovery", "principal_2x2", "max_threads",
     "set_num_threads", "ell_indptr", "edge_morton_order", "recovery_weights", "patch_recovery",
     "tangent_projection6", "smooth_vertex_tensors", "face_metrics", "vertex_area_sums",
-    "intrinsic_patch_recovery", "connection_smoothing",
+    "intrinsic_patch_recovery", "connection_smoothing", "vertex_components",
     "large_call_heap", "with_large_call_heap", "LARGE_CALL_HEAP",
 ]
 
@@ -256,8 +256,13 @@ def ell_indptr(n, width=5):
 
 def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,
               probe_iter=0, max_predicted=np.inf, subdomain=None, subdomain_solve=None,
-              subdomain_ldl=None, overwrite_R=False):
+              subdomain_ldl=None, overwrite_R=False, coupled=False):
     """Fused block PCG on all columns of ``R`` (n, k ≤ 16) for a CSR matrix.
+
+    ``coupled=False``: k independent CG recurrences (one per column); ``True``: one CG
+    on the k columns together (every scalar summed over the columns), so that
+    mixing the columns by an orthogonal matrix (a rotation of the coordinate
+    right-hand sides of Walker's eq. 5.14) mixes the iterates the same way.
 
     Column indices travel as int32 (memory bandwidth: the sweeps are memory-bound).
     Reference: :func:`igl_hhj.hhj._block_pcg`.  Preconditioner: ``M`` =
@@ -318,7 +323,7 @@ def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,
     _threads()
     return _core.block_pcg(indptr, indices, data, Mp, Mi, Mx, dinv, R, float(rtol), int(maxiter),
                            int(probe_iter), float(max_predicted), S,
-                           subdomain_solve if S is not None and ldl is None else None, ldl)
+                           subdomain_solve if S is not None and ldl is None else None, ldl, bool(coupled))
 
 
 def shape_operator_faces(mesh, s):
@@ -459,3 +464,9 @@ def connection_smoothing(mesh, X, C, mass, phase, steps, coefficients, rtol, max
     return _core.connection_smoothing(_i64(mesh.edges), _i64(mesh.edge_faces), _i64(mesh.edge_local_index),
                                       C, mass, phase, X, int(steps), [float(c) for c in coefficients],
                                       float(rtol), int(maxiter))
+
+
+def vertex_components(mesh):
+    """Connected components of the vertex graph: ``(labels (#V,) int32, count)``, labelled in
+    the order of their smallest vertex; vertices of no edge get label 0."""
+    return _core.vertex_components(_i64(mesh.edges), int(mesh.n_vertices))

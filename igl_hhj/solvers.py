@@ -261,18 +261,21 @@ def mass_solver(M, lumped_inv, rtol=1e-13):
 
 def pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None, probe_iter=0,
         max_predicted=np.inf, subdomain=None, subdomain_solve=None, subdomain_ldl=None,
-        overwrite_R=False):
+        overwrite_R=False, coupled=False):
     """Compiled block PCG on all columns of ``R`` (n, k), in groups of 16.
 
     Returns ``(X, iterations, status, relres)`` (see :func:`igl_hhj.kernels.block_pcg`;
     iterations / status are the worst over the groups).  ``overwrite_R`` (k ≤ 16 only):
     R (C-contiguous float64) is used as the residual buffer and holds the final
-    residual afterwards."""
+    residual afterwards.  ``coupled`` (k ≤ 16 only): one CG on all columns
+    (:func:`igl_hhj.kernels.block_pcg`)."""
     if R.shape[1] <= 16:
         return kernels.block_pcg(indptr, indices, data, R, rtol=rtol, maxiter=maxiter, M=M, dinv=dinv,
                                  probe_iter=probe_iter, max_predicted=max_predicted,
                                  subdomain=subdomain, subdomain_solve=subdomain_solve,
-                                 subdomain_ldl=subdomain_ldl, overwrite_R=overwrite_R)
+                                 subdomain_ldl=subdomain_ldl, overwrite_R=overwrite_R, coupled=coupled)
+    if coupled:
+        raise ValueError("coupled PCG takes at most 16 right-hand sides")
     R = np.ascontiguousarray(R, dtype=np.float64)
     X = np.empty_like(R)
     its, statuses, relres = [0], [0], []
@@ -413,7 +416,7 @@ class HHJSystem:
         out[self.perm] = np.einsum("es,esk->ek", self.A_full, v[self.cols])
         return out
 
-    def _pcg(self, rhs, solver, rtol, S, info):
+    def _pcg(self, rhs, solver, rtol, S, info, coupled=False):
         n, k = rhs.shape
         M = (self.indptr, self._cols_flat, self.M.ravel())
         sub = {}
@@ -425,7 +428,7 @@ class HHJSystem:
         if solver == "cg":
             X, it, status, relres = pcg(self.indptr, self._cols_flat, self.A.ravel(), rhs,
                                         rtol=rtol, maxiter=CG_MAXITER, M=M,
-                                        overwrite_R=rhs.shape[1] <= 16, **sub)
+                                        overwrite_R=rhs.shape[1] <= 16, coupled=coupled, **sub)
             info.update(iterations=it, solver="cg")
             if status != 0:
                 raise SolverDidNotConverge(
@@ -441,7 +444,7 @@ class HHJSystem:
         overwrite = rhs.shape[1] <= 16 and rhs.flags.c_contiguous and rhs.dtype == np.float64
         X, it, status, relres = pcg(self.indptr, self._cols_flat, self.A.ravel(), rhs,
                                     rtol=rtol, maxiter=CG_MAXITER, M=M, probe_iter=PROBE_ITER,
-                                    max_predicted=budget, overwrite_R=overwrite, **sub)
+                                    max_predicted=budget, overwrite_R=overwrite, coupled=coupled, **sub)
         info.update(iterations=it, solver="cg")
         if status != 0:
             if n > DIRECT_MAX:
@@ -457,7 +460,7 @@ class HHJSystem:
             info.update(switched=True, solver="direct")
         return X, info
 
-    def solve(self, rhs, solver="auto", rtol=DEFAULT_RTOL, overwrite_rhs=False):
+    def solve(self, rhs, solver="auto", rtol=DEFAULT_RTOL, overwrite_rhs=False, coupled=False):
         """Solve ``A X = rhs`` (#E, k, the mesh's edge order) with the strategy in the module docstring.
 
         Returns
@@ -467,6 +470,9 @@ class HHJSystem:
 
         ``overwrite_rhs=True`` (a C-contiguous float64 ``rhs``) lets the solve use the
         memory of ``rhs`` (its contents are destroyed): one #E × k array less.
+        ``coupled=True``: the PCG runs one recurrence on all k columns
+        (:func:`igl_hhj.kernels.block_pcg`), so that rotating the coordinates of the
+        right-hand sides rotates the solution exactly (the shape operator's solve).
         """
         if solver not in ("auto", "cg", "direct"):
             raise ValueError(f"unknown solver {solver!r}; use 'auto', 'cg' or 'direct'")
@@ -490,7 +496,7 @@ class HHJSystem:
                 X = cholesky_solve(self.csr(), rhs)
                 info["solver"] = "direct"
             else:
-                X, info = self._pcg(rhs, solver, rtol, S, info)
+                X, info = self._pcg(rhs, solver, rtol, S, info, coupled=coupled)
         if not np.isfinite(X).all():
             raise SolverError("the HHJ solve produced non-finite values")
         out = np.take(X, self._iperm, axis=0)     # = scatter out[perm] = X, as a gather

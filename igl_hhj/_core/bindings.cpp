@@ -176,7 +176,8 @@ NB_MODULE(_hhj_core, m) {
                           std::optional<In<double>> dinv, nb::ndarray<double, nb::c_contig, nb::device::cpu> R,
                           double rtol, i64 maxiter,
                           i64 probe_iter, double max_predicted, std::optional<In<i64>> S,
-                          std::optional<nb::callable> subdomain_solve, std::optional<nb::tuple> subdomain_ldl) {
+                          std::optional<nb::callable> subdomain_solve, std::optional<nb::tuple> subdomain_ldl,
+                          bool coupled) {
         need(R.ndim() == 2, "block_pcg: R must be (n, k)");
         const i64 n = R.shape(0);
         const int k = (int)R.shape(1);
@@ -250,7 +251,7 @@ NB_MODULE(_hhj_core, m) {
                                  Mp ? Mp->data() : nullptr, Mp ? Mi->data() : nullptr,
                                  Mp ? Mx->data() : nullptr, dinv ? dinv->data() : nullptr,
                                  R.data(), X.data(), rtol, maxiter, probe_iter, max_predicted, tb.nt,
-                                 sub.nS ? &sub : nullptr);
+                                 sub.nS ? &sub : nullptr, coupled);
         }
         return nb::make_tuple(to_numpy(std::move(X), {(size_t)n, (size_t)k}), res.iterations, res.status,
                               res.relres);
@@ -409,5 +410,18 @@ NB_MODULE(_hhj_core, m) {
                                                &iterations, &ngroups);
         }
         return nb::make_tuple(status, iterations, ngroups);
+    });
+
+    m.def("vertex_components", [](In<i64> E, i64 nV) {
+        need(E.ndim() == 2 && E.shape(1) == 2, "vertex_components: E must be (#E, 2)");
+        const i64 nE = E.shape(0);
+        for (i64 q = 0; q < 2 * nE; ++q) need(E.data()[q] >= 0 && E.data()[q] < nV, "vertex_components: index out of range");
+        std::vector<std::int32_t> label;
+        i64 n;
+        {
+            nb::gil_scoped_release nogil;
+            n = hhj::vertex_groups(nV, E.data(), nE, label);
+        }
+        return nb::make_tuple(to_numpy(std::move(label), {(size_t)nV}), n);
     });
 }

@@ -175,6 +175,7 @@ void vertex_laplacian(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* EL
                       std::vector<i64>* pos_lo = nullptr, std::vector<i64>* pos_hi = nullptr);
 
 // intrinsic_kernels.cpp
+i64 vertex_groups(i64 nV, const i64* E, i64 nE, std::vector<std::int32_t>& label);
 int connection_smoothing(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* ELI, const double* C,
                          const double* m, const double* phase, int steps, const std::vector<double>& binom,
                          double rtol, i64 maxiter, double* X, int nt, i64* iterations, i64* ngroups);
@@ -221,7 +222,7 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
                     const i64* Mp, const std::int32_t* Mi, const double* Mx, const double* dinv,
                     double* R, double* X, double rtol, i64 maxiter,
                     i64 probe_iter, double max_predicted, int nt,
-                    const SubdomainSolve* sub = nullptr);
+                    const SubdomainSolve* sub = nullptr, bool coupled = false);
 
 // Large-call heap scope (heap.cpp): raise glibc's mmap threshold while open; the last
 // exit restores glibc's 32 MiB ceiling and trims.  enter returns whether it is raised,

@@ -142,6 +142,8 @@ int pcg_hz(const HZSystem& S, const std::int32_t* group, i64 ng, const double* b
     return 1;
 }
 
+}  // namespace
+
 // Connected components of the vertex graph (union-find over E), labelled in the order
 // of their smallest vertex; vertices without edges join label 0 (their rows stay 0 in
 // every solve, so they add nothing to any reduction).  Returns the number of labels.
@@ -169,8 +171,6 @@ i64 vertex_groups(i64 nV, const i64* E, i64 nE, std::vector<std::int32_t>& label
     }
     return std::max<i64>(ng, 1);
 }
-
-}  // namespace
 
 // connection_smoothing: X (#V,3) <- (I - (I - G)^order) X in place, G = `steps` implicit
 // steps (M + L_t) Y = M Y_prev solved for the correction (M + L_t) dY = -L_t Y_prev.

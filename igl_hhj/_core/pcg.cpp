@@ -131,7 +131,8 @@ void update(i64 n, int k, const double* alpha, double* X, double* r, const doubl
 PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const double* Ax,
                     const i64* Mp, const std::int32_t* Mi, const double* Mx, const double* dinv,
                     double* R, double* X, double rtol, i64 maxiter,
-                    i64 probe_iter, double max_predicted, int nt, const SubdomainSolve* sub) {
+                    i64 probe_iter, double max_predicted, int nt, const SubdomainSolve* sub,
+                    bool coupled) {
     if (k > 16) throw std::invalid_argument("block_pcg: at most 16 right-hand sides per call");
     PCGResult res;
     res.relres.assign(k, 0.0);
@@ -157,7 +158,17 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
         }
         P.reduce(out);
     };
+    // coupled: one CG on the k columns together (every scalar summed over the columns),
+    // so that an orthogonal mixing of the columns (a rotation of the coordinates of the
+    // HHJ right-hand sides) commutes with the iteration
+    auto couple = [&](std::vector<double>& v) {
+        if (!coupled) return;
+        double sum = 0.0;
+        for (int j = 0; j < k; ++j) sum += v[j];
+        for (int j = 0; j < k; ++j) v[j] = sum;
+    };
     chunk_dot(R, R, bb);
+    couple(bb);
     bool any = false;
     for (int j = 0; j < k; ++j) {
         tol2[j] = rtol * rtol * bb[j];
@@ -191,12 +202,14 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
             for (int j = 0; j < k; ++j) out[j] += rS[(size_t)i * k + j] * zS[(size_t)i * k + j];
     };
     precondition(rz);   // fused: p = dinv r directly
+    couple(rz);
     if (!fused) std::copy(z.begin(), z.end(), p.begin());
     Partials P2(n, k);
     res.status = 1;
     for (i64 it = 1; it <= maxiter; ++it) {
         apply_and_dot(n, k, Ap, Ai, Ax, nullptr, p.data(), q.data(), p.data(), P, nt);
         P.reduce(pq);
+        couple(pq);
         bool breakdown = false;
         for (int j = 0; j < k; ++j) {
             alpha[j] = active[j] ? rz[j] / pq[j] : 0.0;
@@ -206,6 +219,7 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
         update(n, k, alpha.data(), X, r, p.data(), q.data(), fused ? dinv : nullptr, P, &P2, nt);
         if (fused) P2.reduce(rz_new);
         P.reduce(rr);
+        couple(rr);
         res.iterations = it;
         any = false;
         for (int j = 0; j < k; ++j) {
@@ -228,6 +242,7 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
             }
         }
         if (!fused) precondition(rz_new);
+        couple(rz_new);
         for (int j = 0; j < k; ++j) {
             beta[j] = active[j] ? rz_new[j] / rz[j] : 0.0;
             rz[j] = rz_new[j];
