@@ -703,7 +703,7 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
                         rtol, estimated=treatment == "estimate")
     X, N = _intrinsic.vertex_stage(mesh, S, radius, rtol=rtol)
     del S
-    PD1, PD2, PV1, PV2 = _intrinsic.principal(X, N)
+    PD1, PD2, PV1, PV2 = kernels.principal_hz(X, N)
     del X
     ref = mesh.referenced_vertices
     if not ref.all():

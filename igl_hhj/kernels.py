@@ -40,7 +40,8 @@ __all__ = [
     "face_tensors", "lumped_vertex_recovery", "principal_2x2", "max_threads",
     "set_num_threads", "ell_indptr", "edge_morton_order", "recovery_weights", "patch_recovery",
     "tangent_projection6", "smooth_vertex_tensors", "face_metrics", "vertex_area_sums",
-    "intrinsic_patch_recovery", "connection_smoothing", "vertex_components",
+    "intrinsic_patch_recovery", "connection_smoothing", "vertex_components", "transport_phases",
+    "adaptive_radius", "face_times", "principal_hz", "intrinsic_smoothing",
     "large_call_heap", "with_large_call_heap", "LARGE_CALL_HEAP",
 ]
 
@@ -431,9 +432,11 @@ def smooth_vertex_tensors(mesh, X, C, mass, t, steps, coefficients, rtol, maxite
 
 
 def intrinsic_patch_recovery(mesh, S, N, w):
-    """Intrinsic patch recovery (#V, 3) components ``(h, Re z, Im z)``; reference
-    :func:`igl_hhj.intrinsic.recover`.  ``S`` (#F, 3, 3), ``N`` (#V, 3) unit vertex
-    normals, ``w`` (#F,) face weights (rows of unreferenced vertices 0)."""
+    """Intrinsic patch recovery: ``(X, rough)``, X (#V, 3) components ``(h, Re z, Im z)``
+    (reference :func:`igl_hhj.intrinsic.recover`, rows of unreferenced vertices 0) and
+    rough (#V,) the roughness of S_h around each vertex (reference
+    :func:`igl_hhj.intrinsic.roughness`).  ``S`` (#F, 3, 3), ``N`` (#V, 3) unit vertex
+    normals, ``w`` (#F,) face weights."""
     S = _f64(S, "S", (3, 3))
     N = _f64(N, "N", (3,))
     w = _f64(w, "w")
@@ -444,11 +447,11 @@ def intrinsic_patch_recovery(mesh, S, N, w):
                                           float(mesh.mean_edge_length))
 
 
-def connection_smoothing(mesh, X, C, mass, phase, steps, coefficients, rtol, maxiter):
+def connection_smoothing(mesh, X, C, times, mass, phase, steps, coefficients, rtol, maxiter):
     """Twiced implicit diffusion of the components ``X`` (#V, 3) = (h, Re z, Im z), in place.
 
-    Reference: :func:`igl_hhj.intrinsic.smooth`.  ``C`` (#F, 3) per-face stiffness entries
-    (times the per-face diffusion time), ``mass`` (#V,) the floored lumped mass,
+    Reference: :func:`igl_hhj.intrinsic.smooth`.  ``C`` (#F, 3) per-face stiffness entries,
+    ``times`` (#F,) the per-face diffusion time (the stiffness is ``C · times``), ``mass`` (#V,) the floored lumped mass,
     ``phase`` (#E, 2) cos and sin of the spin-2 transport of each edge, ``coefficients``
     binom(order, j)(-1)^(j+1).  Returns ``(status, iterations, components)``; status 0
     when every PCG solve converged (else X is unchanged)."""
@@ -456,13 +459,15 @@ def connection_smoothing(mesh, X, C, mass, phase, steps, coefficients, rtol, max
             and X.shape == (mesh.n_vertices, 3)):
         raise ValueError("connection_smoothing: X must be a C-contiguous float64 (#V, 3) array")
     C = _f64(C, "C", (3,))
+    times = _f64(times, "times")
     mass = _f64(mass, "mass")
     phase = _f64(phase, "phase", (2,))
-    if C.shape[0] != mesh.n_faces or mass.shape != (mesh.n_vertices,) or phase.shape[0] != mesh.n_edges:
-        raise ValueError("connection_smoothing: C must be (#F, 3), mass (#V,) and phase (#E, 2)")
+    if C.shape[0] != mesh.n_faces or times.shape != (mesh.n_faces,) or mass.shape != (mesh.n_vertices,) \
+            or phase.shape[0] != mesh.n_edges:
+        raise ValueError("connection_smoothing: C must be (#F, 3), times (#F,), mass (#V,) and phase (#E, 2)")
     _threads()
     return _core.connection_smoothing(_i64(mesh.edges), _i64(mesh.edge_faces), _i64(mesh.edge_local_index),
-                                      C, mass, phase, X, int(steps), [float(c) for c in coefficients],
+                                      C, times, mass, phase, X, int(steps), [float(c) for c in coefficients],
                                       float(rtol), int(maxiter))
 
 
@@ -470,3 +475,68 @@ def vertex_components(mesh):
     """Connected components of the vertex graph: ``(labels (#V,) int32, count)``, labelled in
     the order of their smallest vertex; vertices of no edge get label 0."""
     return _core.vertex_components(_i64(mesh.edges), int(mesh.n_vertices))
+
+
+def transport_phases(mesh, N):
+    """(#E, 2) cos and sin of the spin-2 transport of each edge; reference
+    :func:`igl_hhj.intrinsic.transport_phase_components`."""
+    N = _f64(N, "N", (3,))
+    if N.shape[0] != mesh.n_vertices:
+        raise ValueError("transport_phases: N must be (#V, 3)")
+    _threads()
+    return _core.transport_phases(N, _i64(mesh.edges))
+
+
+def adaptive_radius(mesh, pilot, rough, radius, gain, power, lo, hi):
+    """Per-face smoothing radius (#F,); reference :func:`igl_hhj.intrinsic.adaptive_radius`."""
+    pilot = _f64(pilot, "pilot", (3,))
+    rough = _f64(rough, "rough")
+    if pilot.shape[0] != mesh.n_vertices or rough.shape != (mesh.n_vertices,):
+        raise ValueError("adaptive_radius: pilot must be (#V, 3) and rough (#V,)")
+    return _core.adaptive_radius(mesh.V, mesh.F, pilot, rough, float(radius), float(gain), float(power),
+                                 float(lo), float(hi))
+
+
+def face_times(mesh, radius, factor, steps):
+    """Per-face diffusion times ``(factor · r_T · h_T)² / steps`` (#F,), ``radius`` a number or
+    (#F,); reference :func:`igl_hhj.intrinsic.smoothing_times`."""
+    r = np.atleast_1d(_f64(radius, "radius"))
+    if r.shape not in ((1,), (mesh.n_faces,)):
+        raise ValueError("face_times: radius must be a number or (#F,)")
+    _threads()
+    return _core.face_times(mesh.V, mesh.F, r, float(factor), int(steps))
+
+
+def principal_hz(X, N):
+    """Principal directions and curvatures of components (h, Re z, Im z) (n, 3) in the frames
+    of N (n, 3): ``(PD1, PD2, PV1, PV2)``; reference :func:`igl_hhj.intrinsic.principal`."""
+    X = _f64(X, "X", (3,))
+    N = _f64(N, "N", (3,))
+    if X.shape[0] != N.shape[0]:
+        raise ValueError(f"X and N must have the same length, got {X.shape[0]} and {N.shape[0]}")
+    _threads()
+    return _core.principal_hz(X, N)
+
+
+def intrinsic_smoothing(mesh, X, C, mass, phase, rough, radius, *, per_radius, pilot_radius, pilot_rtol,
+                        gain, power, bounds, steps, coefficients, rtol, maxiter):
+    """The drop-in's smoothing in one call, in place on ``X`` (#V, 3): the pilot step, the
+    adaptive per-face radius, the twiced smoothing at it (reference
+    :func:`igl_hhj.intrinsic.vertex_stage_reference`).  Returns ``(status, iterations,
+    components, radius (#F,))``; status 0 when every solve converged (else X unchanged)."""
+    if not (isinstance(X, np.ndarray) and X.dtype == np.float64 and X.flags.c_contiguous
+            and X.shape == (mesh.n_vertices, 3)):
+        raise ValueError("intrinsic_smoothing: X must be a C-contiguous float64 (#V, 3) array")
+    C = _f64(C, "C", (3,))
+    mass = _f64(mass, "mass")
+    phase = _f64(phase, "phase", (2,))
+    rough = _f64(rough, "rough")
+    if C.shape[0] != mesh.n_faces or mass.shape != (mesh.n_vertices,) or phase.shape[0] != mesh.n_edges \
+            or rough.shape != (mesh.n_vertices,):
+        raise ValueError("intrinsic_smoothing: C must be (#F, 3), mass and rough (#V,), phase (#E, 2)")
+    _threads()
+    return _core.intrinsic_smoothing(mesh.V, mesh.F, _i64(mesh.edges), _i64(mesh.edge_faces),
+                                     _i64(mesh.edge_local_index), C, mass, phase, rough, X, float(radius),
+                                     float(per_radius), float(pilot_radius), float(pilot_rtol), float(gain),
+                                     float(power), float(bounds[0]), float(bounds[1]), int(steps),
+                                     [float(c) for c in coefficients], float(rtol), int(maxiter))

@@ -376,17 +376,18 @@ NB_MODULE(_hhj_core, m) {
         const i64 nF = F.shape(0), nV = V.shape(0);
         need(S.shape(0) == (size_t)nF && N.shape(0) == (size_t)nV && w.shape(0) == (size_t)nF &&
              ref.shape(0) == (size_t)nV, "intrinsic_patch_recovery: shapes");
-        std::vector<double> X((size_t)nV * 3);
+        std::vector<double> X((size_t)nV * 3), rough(nV);
         {
             nb::gil_scoped_release nogil;
             hhj::ThreadBudget tb(nF);
             hhj::intrinsic_patch_recovery(V.data(), F.data(), nF, nV, S.data(), N.data(), w.data(), ref.data(),
-                                          h, X.data(), tb.nt);
+                                          h, X.data(), rough.data(), tb.nt);
         }
-        return to_numpy(std::move(X), {(size_t)nV, 3});
+        return nb::make_tuple(to_numpy(std::move(X), {(size_t)nV, 3}), to_numpy(std::move(rough), {(size_t)nV}));
     });
 
-    m.def("connection_smoothing", [](In<i64> E, In<i64> EF, In<i64> ELI, In<double> C, In<double> mass,
+    m.def("connection_smoothing", [](In<i64> E, In<i64> EF, In<i64> ELI, In<double> C, In<double> tface,
+                                     In<double> mass,
                                      In<double> phase, nb::ndarray<double, nb::c_contig, nb::device::cpu> X,
                                      int steps, std::vector<double> binom, double rtol, i64 maxiter) {
         const i64 nV = X.shape(0), nE = E.shape(0);
@@ -396,6 +397,7 @@ NB_MODULE(_hhj_core, m) {
              "connection_smoothing: topology shapes");
         need(nV < ((i64)1 << 31), "connection_smoothing: at most 2**31 - 1 vertices");
         const i64 nF = C.shape(0);
+        need(tface.ndim() == 1 && tface.shape(0) == (size_t)nF, "connection_smoothing: tface must be (#F,)");
         const i64* e = E.data();
         for (i64 q = 0; q < 2 * nE; ++q) need(e[q] >= 0 && e[q] < nV, "connection_smoothing: edge index out of range");
         for (i64 q = 0; q < 2 * nE; ++q)
@@ -405,9 +407,9 @@ NB_MODULE(_hhj_core, m) {
         {
             nb::gil_scoped_release nogil;
             hhj::ThreadBudget tb(nV);
-            status = hhj::connection_smoothing(nV, E.data(), nE, EF.data(), ELI.data(), C.data(), mass.data(),
-                                               phase.data(), steps, binom, rtol, maxiter, X.data(), tb.nt,
-                                               &iterations, &ngroups);
+            status = hhj::connection_smoothing(nV, E.data(), nE, EF.data(), ELI.data(), C.data(), tface.data(),
+                                               nF, mass.data(), phase.data(), steps, binom, rtol, maxiter,
+                                               X.data(), tb.nt, &iterations, &ngroups);
         }
         return nb::make_tuple(status, iterations, ngroups);
     });
@@ -423,5 +425,95 @@ NB_MODULE(_hhj_core, m) {
             n = hhj::vertex_groups(nV, E.data(), nE, label);
         }
         return nb::make_tuple(to_numpy(std::move(label), {(size_t)nV}), n);
+    });
+
+    m.def("transport_phases", [](In<double> N, In<i64> E) {
+        const i64 nV = N.shape(0), nE = E.shape(0);
+        need(N.ndim() == 2 && N.shape(1) == 3 && E.ndim() == 2 && E.shape(1) == 2, "transport_phases: shapes");
+        for (i64 q = 0; q < 2 * nE; ++q) need(E.data()[q] >= 0 && E.data()[q] < nV, "transport_phases: index out of range");
+        std::vector<double> ph((size_t)nE * 2);
+        {
+            nb::gil_scoped_release nogil;
+            hhj::ThreadBudget tb(nE);
+            hhj::transport_phases(N.data(), nV, E.data(), nE, ph.data(), tb.nt);
+        }
+        return to_numpy(std::move(ph), {(size_t)nE, 2});
+    });
+
+    m.def("adaptive_radius", [](In<double> V, In<i64> F, In<double> P, In<double> rough, double radius,
+                                double gain, double power, double lo, double hi) {
+        const i64 nF = F.shape(0), nV = V.shape(0);
+        need(P.shape(0) == (size_t)nV && P.shape(1) == 3 && rough.shape(0) == (size_t)nV, "adaptive_radius: shapes");
+        std::vector<double> r(nF);
+        {
+            nb::gil_scoped_release nogil;
+            hhj::adaptive_radius(V.data(), F.data(), nF, nV, P.data(), rough.data(), radius, gain, power, lo, hi,
+                                 r.data());
+        }
+        return to_numpy(std::move(r), {(size_t)nF});
+    });
+
+    m.def("face_times", [](In<double> V, In<i64> F, In<double> r, double factor, int steps) {
+        const i64 nF = F.shape(0);
+        need(F.ndim() == 2 && F.shape(1) == 3 && (r.shape(0) == (size_t)nF || r.shape(0) == 1), "face_times: shapes");
+        need(steps >= 1, "face_times: steps >= 1");
+        const i64 nV = V.shape(0);
+        for (i64 q = 0; q < 3 * nF; ++q) need(F.data()[q] >= 0 && F.data()[q] < nV, "face_times: index out of range");
+        std::vector<double> t(nF);
+        {
+            nb::gil_scoped_release nogil;
+            hhj::ThreadBudget tb(nF);
+            hhj::face_times(V.data(), F.data(), nF, r.data(), r.shape(0) == (size_t)nF && nF > 1 ? 1 : (r.shape(0) == 1 ? 0 : 1),
+                            factor, steps, t.data(), tb.nt);
+        }
+        return to_numpy(std::move(t), {(size_t)nF});
+    });
+
+    m.def("intrinsic_smoothing", [](In<double> V, In<i64> F, In<i64> E, In<i64> EF, In<i64> ELI, In<double> C,
+                                    In<double> mass, In<double> phase, In<double> rough,
+                                    nb::ndarray<double, nb::c_contig, nb::device::cpu> X, double radius,
+                                    double per_radius, double pilot_radius, double pilot_rtol, double gain,
+                                    double power, double lo, double hi, int steps, std::vector<double> binom,
+                                    double rtol, i64 maxiter) {
+        const i64 nV = X.shape(0), nE = E.shape(0), nF = F.shape(0);
+        need(V.shape(0) == (size_t)nV && X.ndim() == 2 && X.shape(1) == 3 && mass.shape(0) == (size_t)nV &&
+             rough.shape(0) == (size_t)nV, "intrinsic_smoothing: X, mass, rough");
+        need(EF.shape(0) == (size_t)nE && ELI.shape(0) == (size_t)nE && C.ndim() == 2 && C.shape(0) == (size_t)nF &&
+             C.shape(1) == 3 && phase.ndim() == 2 && phase.shape(0) == (size_t)nE && phase.shape(1) == 2,
+             "intrinsic_smoothing: topology shapes");
+        need(nV < ((i64)1 << 31), "intrinsic_smoothing: at most 2**31 - 1 vertices");
+        need(steps >= 1, "intrinsic_smoothing: steps >= 1");
+        for (i64 q = 0; q < 3 * nF; ++q) need(F.data()[q] >= 0 && F.data()[q] < nV, "intrinsic_smoothing: F out of range");
+        for (i64 q = 0; q < 2 * nE; ++q) need(E.data()[q] >= 0 && E.data()[q] < nV, "intrinsic_smoothing: E out of range");
+        for (i64 q = 0; q < 2 * nE; ++q)
+            need(EF.data()[q] < nF && ELI.data()[q] < 3, "intrinsic_smoothing: edge_faces out of range");
+        std::vector<double> r(nF);
+        int status;
+        i64 iterations = 0, ngroups = 0;
+        {
+            nb::gil_scoped_release nogil;
+            hhj::ThreadBudget tb(nV);
+            status = hhj::intrinsic_smoothing(V.data(), F.data(), nF, nV, E.data(), nE, EF.data(), ELI.data(),
+                                              C.data(), mass.data(), phase.data(), rough.data(), radius,
+                                              per_radius, pilot_radius, pilot_rtol, gain, power, lo, hi, steps,
+                                              binom, rtol, maxiter, X.data(), r.data(), tb.nt, &iterations,
+                                              &ngroups);
+        }
+        return nb::make_tuple(status, iterations, ngroups, to_numpy(std::move(r), {(size_t)nF}));
+    });
+
+    m.def("principal_hz", [](In<double> X, In<double> N) {
+        const i64 n = X.shape(0);
+        need(X.ndim() == 2 && X.shape(1) == 3 && N.ndim() == 2 && N.shape(0) == (size_t)n && N.shape(1) == 3,
+             "principal_hz: X and N must be (n, 3)");
+        std::vector<double> PD1((size_t)n * 3), PD2((size_t)n * 3), PV1(n), PV2(n);
+        {
+            nb::gil_scoped_release nogil;
+            hhj::ThreadBudget tb(n);
+            hhj::principal_hz(X.data(), N.data(), n, PD1.data(), PD2.data(), PV1.data(), PV2.data(), tb.nt);
+        }
+        const size_t nn = n;
+        return nb::make_tuple(to_numpy(std::move(PD1), {nn, 3}), to_numpy(std::move(PD2), {nn, 3}),
+                              to_numpy(std::move(PV1), {nn}), to_numpy(std::move(PV2), {nn}));
     });
 }

@@ -168,7 +168,7 @@ void tangent_projection6(double* X, const double* N, const unsigned char* ref, i
                          int nt);
 void intrinsic_patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S,
                               const double* N, const double* w, const unsigned char* ref, double h,
-                              double* X, int nt);
+                              double* X, double* rough, int nt);
 void vertex_laplacian(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* ELI, const double* C,
                       std::vector<i64>& indptr, std::vector<std::int32_t>& indices,
                       std::vector<double>& L, std::vector<i64>& diag_pos,
@@ -176,9 +176,23 @@ void vertex_laplacian(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* EL
 
 // intrinsic_kernels.cpp
 i64 vertex_groups(i64 nV, const i64* E, i64 nE, std::vector<std::int32_t>& label);
-int connection_smoothing(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* ELI, const double* C,
-                         const double* m, const double* phase, int steps, const std::vector<double>& binom,
-                         double rtol, i64 maxiter, double* X, int nt, i64* iterations, i64* ngroups);
+void transport_phases(const double* N, i64 nV, const i64* E, i64 nE, double* phase, int nt);
+void adaptive_radius(const double* V, const i64* F, i64 nF, i64 nV, const double* P, const double* rough,
+                     double radius, double gain, double power, double lo, double hi, double* r);
+int connection_smoothing(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* ELI, const double* C0,
+                         const double* tface, i64 nF, const double* m, const double* phase, int steps,
+                         const std::vector<double>& binom, double rtol, i64 maxiter, double* X, int nt,
+                         i64* iterations, i64* ngroups);
+void face_times(const double* V, const i64* F, i64 nF, const double* r, int r_stride, double factor,
+                int steps, double* t, int nt);
+void principal_hz(const double* X, const double* N, i64 n, double* PD1, double* PD2, double* PV1,
+                  double* PV2, int nt);
+int intrinsic_smoothing(const double* V, const i64* F, i64 nF, i64 nV, const i64* E, i64 nE, const i64* EF,
+                        const i64* ELI, const double* C0, const double* m, const double* phase,
+                        const double* rough, double radius, double per_radius, double pilot_radius,
+                        double pilot_rtol, double gain, double power, double lo, double hi, int steps,
+                        const std::vector<double>& binom, double rtol, i64 maxiter, double* X, double* r,
+                        int nt, i64* iterations, i64* ngroups);
 int smooth_vertex_tensors(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* ELI, const double* C,
                           const double* m, double t, int steps, const std::vector<double>& binom,
                           double rtol, i64 maxiter, double* X, int nt, i64* iterations);

@@ -172,55 +172,245 @@ i64 vertex_groups(i64 nV, const i64* E, i64 nE, std::vector<std::int32_t>& label
     return std::max<i64>(ng, 1);
 }
 
+// transport_phases (intrinsic.transport_phase_components): per edge (i < j) the cos and
+// sin of 2 rho, rho the angle in the frame of i of e1_j carried onto the plane of i by
+// the minimal rotation N_j -> N_i (x^2 - y^2, 2xy over x^2 + y^2); 0, 0 where undefined.
+// Frames as tangent_frame, +z for non-finite normals.
+void transport_phases(const double* N, i64 nV, const i64* E, i64 nE, double* phase, int nt) {
+    std::vector<double> fr((size_t)nV * 9);
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+    for (i64 v = 0; v < nV; ++v) {
+        double* n = &fr[9 * v];
+        const bool fin = std::isfinite(N[3 * v]) && std::isfinite(N[3 * v + 1]) && std::isfinite(N[3 * v + 2]);
+        for (int a = 0; a < 3; ++a) n[a] = fin ? N[3 * v + a] : (a == 2 ? 1.0 : 0.0);
+        tangent_frame(n, n + 3, n + 6);
+    }
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+    for (i64 e = 0; e < nE; ++e) {
+        const double* fi = &fr[9 * E[2 * e]];
+        const double* fj = &fr[9 * E[2 * e + 1]];
+        double t[3];
+        min_rotation(fj + 3, fj, fi, t);
+        const double x = dot3(t, fi + 3), y = dot3(t, fi + 6), n2 = x * x + y * y;
+        double c = (x * x - y * y) / n2, s = 2.0 * x * y / n2;
+        if (!(std::isfinite(c) && std::isfinite(s))) { c = 0.0; s = 0.0; }
+        phase[2 * e] = c;
+        phase[2 * e + 1] = s;
+    }
+}
+
+// adaptive_radius (intrinsic.adaptive_radius): r_T = radius * mean over T's corners of
+// a_v = clip(gain rho_v^power / max(c_v, 1e-3), lo, hi), rho and c the area-weighted
+// ring means of rough and of h_v (|h| + |z|) of the pilot P (#V,3); non-finite a -> 1.
+void adaptive_radius(const double* V, const i64* F, i64 nF, i64 nV, const double* P, const double* rough,
+                     double radius, double gain, double power, double lo, double hi, double* r) {
+    std::vector<double> hsum(nV, 0.0), cnt(nV, 0.0), area(nF), hT(nF);
+    for (i64 f = 0; f < nF; ++f) {
+        double c[3];
+        const double* x0 = V + 3 * F[3 * f];
+        const double* x1 = V + 3 * F[3 * f + 1];
+        const double* x2 = V + 3 * F[3 * f + 2];
+        const double a[3] = {x1[0] - x0[0], x1[1] - x0[1], x1[2] - x0[2]};
+        const double b[3] = {x2[0] - x0[0], x2[1] - x0[1], x2[2] - x0[2]};
+        cross3(a, b, c);
+        area[f] = 0.5 * std::sqrt(dot3(c, c));
+        double h = 0.0;
+        for (int i = 0; i < 3; ++i) {
+            const double* p = V + 3 * F[3 * f + (i + 1) % 3];
+            const double* q = V + 3 * F[3 * f + (i + 2) % 3];
+            const double d[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+            h += std::sqrt(dot3(d, d)) / 3.0;
+        }
+        hT[f] = h;
+        for (int k = 0; k < 3; ++k) { hsum[F[3 * f + k]] += h; cnt[F[3 * f + k]] += 1.0; }
+    }
+    std::vector<double> cv(nV), num_c(nV, 0.0), num_r(nV, 0.0), den(nV, 0.0);
+    for (i64 v = 0; v < nV; ++v) {
+        const double hv = hsum[v] / std::max(cnt[v], 1.0);
+        cv[v] = hv * (std::fabs(P[3 * v]) + std::hypot(P[3 * v + 1], P[3 * v + 2]));
+    }
+    for (i64 f = 0; f < nF; ++f) {
+        double mc = 0.0, mr = 0.0;
+        for (int k = 0; k < 3; ++k) { mc += cv[F[3 * f + k]] / 3.0; mr += rough[F[3 * f + k]] / 3.0; }
+        for (int k = 0; k < 3; ++k) {
+            const i64 v = F[3 * f + k];
+            num_c[v] += area[f] * mc; num_r[v] += area[f] * mr; den[v] += area[f];
+        }
+    }
+    std::vector<double> a(nV);
+    for (i64 v = 0; v < nV; ++v) {
+        const double c = num_c[v] / den[v], rho = num_r[v] / den[v];
+        double x = gain * std::pow(rho, power) / std::max(c, 1e-3);
+        x = std::isfinite(x) ? std::min(std::max(x, lo), hi) : 1.0;
+        a[v] = x;
+    }
+    for (i64 f = 0; f < nF; ++f)
+        r[f] = radius * (a[F[3 * f]] + a[F[3 * f + 1]] + a[F[3 * f + 2]]) / 3.0;
+}
+
+// principal_hz (intrinsic.principal): k1,2 = h +- |z|, PD1 = cos(phi) e1 + sin(phi) e2,
+// phi = arg(z) / 2, PD2 = N x PD1, in the frames of N (tangent_frame; +z if non-finite).
+void principal_hz(const double* X, const double* N, i64 n, double* PD1, double* PD2, double* PV1,
+                  double* PV2, int nt) {
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+    for (i64 v = 0; v < n; ++v) {
+        double nn[3], e1[3], e2[3];
+        const bool fin = std::isfinite(N[3 * v]) && std::isfinite(N[3 * v + 1]) && std::isfinite(N[3 * v + 2]);
+        for (int a = 0; a < 3; ++a) nn[a] = fin ? N[3 * v + a] : (a == 2 ? 1.0 : 0.0);
+        tangent_frame(nn, e1, e2);
+        const double h = X[3 * v], a = std::hypot(X[3 * v + 1], X[3 * v + 2]);
+        const double phi = 0.5 * std::atan2(X[3 * v + 2], X[3 * v + 1]);
+        const double c = std::cos(phi), s = std::sin(phi);
+        double d[3];
+        for (int q = 0; q < 3; ++q) d[q] = c * e1[q] + s * e2[q];
+        double d2[3];
+        cross3(N + 3 * v, d, d2);
+        for (int q = 0; q < 3; ++q) { PD1[3 * v + q] = d[q]; PD2[3 * v + q] = d2[q]; }
+        PV1[v] = h + a;
+        PV2[v] = h - a;
+    }
+}
+
+// face_times (intrinsic.smoothing_times): t[f] = (factor r_f h_f)^2 / steps, h_f the mean
+// edge length of f, r (#F,) or a scalar (r_stride 0).
+void face_times(const double* V, const i64* F, i64 nF, const double* r, int r_stride, double factor,
+                int steps, double* t, int nt) {
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+    for (i64 f = 0; f < nF; ++f) {
+        double h = 0.0;
+        for (int i = 0; i < 3; ++i) {
+            const double* p = V + 3 * F[3 * f + (i + 1) % 3];
+            const double* q = V + 3 * F[3 * f + (i + 2) % 3];
+            const double d[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+            h += std::sqrt(dot3(d, d));
+        }
+        const double l = factor * r[f * r_stride] * (h / 3.0);
+        t[f] = l * l / steps;
+    }
+}
+
 // connection_smoothing: X (#V,3) <- (I - (I - G)^order) X in place, G = `steps` implicit
 // steps (M + L_t) Y = M Y_prev solved for the correction (M + L_t) dY = -L_t Y_prev.
-// C (#F,3) per-face stiffness entries (cotangent x reliability x time t_T), m (#V,) the
+// C0 (#F,3) per-face stiffness entries (cotangent x reliability), tface (#F,) the per-face
+// time t_T (the stiffness is C0 t_T), m (#V,) the
 // floored lumped mass, phase (#E,2) (cos, sin) of r_e = e^{2 i rho_e} for edge (i < j).
 // The CG scalars are per connected component of the vertex graph (vertex_groups).
 // Returns 0, or the status of the first solve that did not converge (X is then
 // unchanged); *ngroups_out the number of components.
-int connection_smoothing(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* ELI, const double* C,
-                         const double* m, const double* phase, int steps, const std::vector<double>& binom,
-                         double rtol, i64 maxiter, double* X, int nt, i64* iterations, i64* ngroups_out) {
-    std::vector<std::int32_t> label;
-    const i64 ngroups = vertex_groups(nV, E, nE, label);
-    const std::int32_t* group = label.data();
-    *ngroups_out = ngroups;
+namespace {
+
+// The structure of the smoothing system (built once per call) and its values for given
+// per-face times t: w_e = sum over the edge's faces of C0[f, i] t_f, A = M + L_t.
+struct HZProblem {
     HZSystem S;
-    S.n = nV;
     std::vector<i64> diag_pos, pos_lo, pos_hi;
-    vertex_laplacian(nV, E, nE, EF, ELI, C, S.indptr, S.indices, S.a, diag_pos, &pos_lo, &pos_hi);
-    const size_t nnz = S.a.size();
-    S.pc.assign(nnz, 1.0);
-    S.ps.assign(nnz, 0.0);
-    for (i64 e = 0; e < nE; ++e) {
-        const double c = phase[2 * e], s = phase[2 * e + 1];
-        S.pc[pos_lo[e]] = c; S.ps[pos_lo[e]] = s;      // row min(e): z of max(e) in the frame of min(e)
-        S.pc[pos_hi[e]] = c; S.ps[pos_hi[e]] = -s;     // row max(e): the inverse transport
-    }
-    // A = M + L_t; -L_t Y = M Y - A Y
-    S.dinv.resize(nV);
-    for (i64 v = 0; v < nV; ++v) {
-        S.a[diag_pos[v]] += m[v];
-        S.dinv[v] = 1.0 / S.a[diag_pos[v]];
-    }
-    const size_t n3 = (size_t)nV * 3;
-    std::vector<double> Y(X, X + n3), R(n3), AY(n3), dY(n3), acc(n3, 0.0);
-    *iterations = 0;
-    for (size_t j = 0; j < binom.size(); ++j) {
-        for (int st = 0; st < steps; ++st) {
-            apply(S, Y.data(), AY.data(), nt);
-            for (size_t q = 0; q < n3; ++q) R[q] = m[q / 3] * Y[q] - AY[q];
-            i64 its = 0;
-            const int status = pcg_hz(S, group, ngroups, R.data(), dY.data(), rtol, maxiter, nt, &its);
-            *iterations += its;
-            if (status != 0) return status;
-            for (size_t q = 0; q < n3; ++q) Y[q] += std::isfinite(dY[q]) ? dY[q] : 0.0;
+    std::vector<std::int32_t> label;
+    i64 ngroups = 1;
+    const i64 *E = nullptr, *EF = nullptr, *ELI = nullptr;
+    const double *C0 = nullptr, *m = nullptr;
+    i64 nE = 0;
+
+    HZProblem(i64 nV, const i64* E_, i64 nE_, const i64* EF_, const i64* ELI_, const double* C0_,
+              const double* m_, const double* phase)
+        : E(E_), EF(EF_), ELI(ELI_), C0(C0_), m(m_), nE(nE_) {
+        ngroups = vertex_groups(nV, E, nE, label);
+        S.n = nV;
+        vertex_laplacian(nV, E, nE, EF, ELI, C0, S.indptr, S.indices, S.a, diag_pos, &pos_lo, &pos_hi);
+        const size_t nnz = S.a.size();
+        S.pc.assign(nnz, 1.0);
+        S.ps.assign(nnz, 0.0);
+        for (i64 e = 0; e < nE; ++e) {
+            const double c = phase[2 * e], s = phase[2 * e + 1];
+            S.pc[pos_lo[e]] = c; S.ps[pos_lo[e]] = s;      // row min(e): z of max(e) in the frame of min(e)
+            S.pc[pos_hi[e]] = c; S.ps[pos_hi[e]] = -s;     // row max(e): the inverse transport
         }
-        for (size_t q = 0; q < n3; ++q) acc[q] += binom[j] * Y[q];
+        S.dinv.resize(nV);
     }
-    std::copy(acc.begin(), acc.end(), X);
-    return 0;
+
+    void fill(const double* t) {
+        const i64 nV = S.n;
+        for (i64 v = 0; v < nV; ++v) S.a[diag_pos[v]] = m[v];
+        for (i64 e = 0; e < nE; ++e) {
+            double we = 0.0;
+            for (int s = 0; s < 2; ++s) {
+                const i64 f = EF[2 * e + s];
+                if (f >= 0) we += C0[3 * f + ELI[2 * e + s]] * t[f];
+            }
+            S.a[pos_lo[e]] = -we;
+            S.a[pos_hi[e]] = -we;
+            S.a[diag_pos[E[2 * e]]] += we;
+            S.a[diag_pos[E[2 * e + 1]]] += we;
+        }
+        for (i64 v = 0; v < nV; ++v) S.dinv[v] = 1.0 / S.a[diag_pos[v]];
+    }
+
+    // X <- (I - (I - G)^order) X, G = `steps` implicit steps; X unchanged on failure
+    int run(double* X, int steps, const std::vector<double>& binom, double rtol, i64 maxiter, int nt,
+            i64* iterations) {
+        const size_t n3 = (size_t)S.n * 3;
+        std::vector<double> Y(X, X + n3), R(n3), AY(n3), dY(n3), acc(n3, 0.0);
+        for (size_t j = 0; j < binom.size(); ++j) {
+            for (int st = 0; st < steps; ++st) {
+                apply(S, Y.data(), AY.data(), nt);
+                for (size_t q = 0; q < n3; ++q) R[q] = m[q / 3] * Y[q] - AY[q];
+                i64 its = 0;
+                const int status = pcg_hz(S, label.data(), ngroups, R.data(), dY.data(), rtol, maxiter, nt, &its);
+                *iterations += its;
+                if (status != 0) return status;
+                for (size_t q = 0; q < n3; ++q) Y[q] += std::isfinite(dY[q]) ? dY[q] : 0.0;
+            }
+            for (size_t q = 0; q < n3; ++q) acc[q] += binom[j] * Y[q];
+        }
+        std::copy(acc.begin(), acc.end(), X);
+        return 0;
+    }
+};
+
+}  // namespace
+
+int connection_smoothing(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* ELI, const double* C0,
+                         const double* tface, i64 nF, const double* m, const double* phase, int steps,
+                         const std::vector<double>& binom, double rtol, i64 maxiter, double* X, int nt,
+                         i64* iterations, i64* ngroups_out) {
+    (void)nF;
+    HZProblem P(nV, E, nE, EF, ELI, C0, m, phase);
+    *ngroups_out = P.ngroups;
+    P.fill(tface);
+    *iterations = 0;
+    return P.run(X, steps, binom, rtol, maxiter, nt, iterations);
+}
+
+// intrinsic_smoothing (intrinsic.vertex_stage): the pilot (one implicit step at
+// pilot_radius, to pilot_rtol), the adaptive per-face radius (adaptive_radius, written
+// to r (#F,)), then the twiced smoothing at it, on one system structure.  Returns the
+// status of the first failed solve (1: pilot, else the final's; X unchanged) or 0.
+int intrinsic_smoothing(const double* V, const i64* F, i64 nF, i64 nV, const i64* E, i64 nE, const i64* EF,
+                        const i64* ELI, const double* C0, const double* m, const double* phase,
+                        const double* rough, double radius, double per_radius, double pilot_radius,
+                        double pilot_rtol, double gain, double power, double lo, double hi, int steps,
+                        const std::vector<double>& binom, double rtol, i64 maxiter, double* X, double* r,
+                        int nt, i64* iterations, i64* ngroups_out) {
+    HZProblem P(nV, E, nE, EF, ELI, C0, m, phase);
+    *ngroups_out = P.ngroups;
+    *iterations = 0;
+    std::vector<double> t(nF), pilot(X, X + (size_t)nV * 3);
+    face_times(V, F, nF, &pilot_radius, 0, per_radius, 1, t.data(), nt);
+    P.fill(t.data());
+    int status = P.run(pilot.data(), 1, {1.0}, pilot_rtol, maxiter, nt, iterations);
+    if (status != 0) return status;
+    adaptive_radius(V, F, nF, nV, pilot.data(), rough, radius, gain, power, lo, hi, r);
+    std::vector<double>().swap(pilot);
+    face_times(V, F, nF, r, 1, per_radius, steps, t.data(), nt);
+    P.fill(t.data());
+    return P.run(X, steps, binom, rtol, maxiter, nt, iterations);
 }
 
 }  // namespace hhj

@@ -179,9 +179,12 @@ void patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double*
 // intrinsic_patch_recovery (intrinsic.recover): the corner components (h, Re z, Im z) of
 // R S_T R^T in the frame of v, R the minimal rotation nu_T -> N_v (corner weight w_T
 // where nu_T . N_v > 0, else 0), fitted by patch_fit.  X (#V,3), rows of unreferenced 0.
+// rough (#V,) or nullptr: intrinsic.roughness, h_v sqrt(sum |T| |Y_T - X_v|^2 / sum |T|)
+// over the corners of v, h_v the mean over them of the faces' mean edge lengths (0 at
+// unreferenced vertices).
 void intrinsic_patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S,
                               const double* N, const double* w, const unsigned char* ref, double h,
-                              double* X, int nt) {
+                              double* X, double* rough, int nt) {
     // corner components and cosines, one pass over faces (parallel: no scatter)
     std::vector<double> Y((size_t)nF * 9), cosine((size_t)nF * 3);
 #ifdef IGL_HHJ_OPENMP
@@ -220,6 +223,36 @@ void intrinsic_patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, con
                   const double* y = &Y[9 * f + 3 * c];
                   for (int q = 0; q < 3; ++q) X[3 * v + q] += k * y[q];
               });
+    if (!rough) return;
+    std::vector<double> acc((size_t)nV * 3, 0.0);     // sum |T| d^2, sum |T|, sum h_T
+    std::vector<i64> cnt(nV, 0);
+    for (i64 f = 0; f < nF; ++f) {
+        double c[3];
+        face_cross(V, F, f, c);
+        const double area = 0.5 * std::sqrt(dot3(c, c));
+        double hT = 0.0;
+        for (int i = 0; i < 3; ++i) {
+            const double* a = V + 3 * F[3 * f + (i + 1) % 3];
+            const double* b = V + 3 * F[3 * f + (i + 2) % 3];
+            const double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+            hT += std::sqrt(dot3(d, d)) / 3.0;
+        }
+        for (int k = 0; k < 3; ++k) {
+            const i64 v = F[3 * f + k];
+            const double* y = &Y[9 * f + 3 * k];
+            double d2 = 0.0;
+            for (int q = 0; q < 3; ++q) d2 += (y[q] - X[3 * v + q]) * (y[q] - X[3 * v + q]);
+            acc[3 * v] += area * d2;
+            acc[3 * v + 1] += area;
+            acc[3 * v + 2] += hT;
+            ++cnt[v];
+        }
+    }
+    for (i64 v = 0; v < nV; ++v) {
+        const double r = cnt[v] && acc[3 * v + 1] > 0
+                             ? acc[3 * v + 2] / cnt[v] * std::sqrt(acc[3 * v] / acc[3 * v + 1]) : 0.0;
+        rough[v] = std::isfinite(r) ? r : 0.0;
+    }
 }
 
 // tangent_projection6: X[r] <- P S P (symmetrised) + keep_trace * (N^T S N) P / 2,
