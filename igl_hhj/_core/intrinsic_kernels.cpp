@@ -44,100 +44,129 @@ void apply(const HZSystem& S, const double* x, double* y, int nt) {
     }
 }
 
-// out[2 g + part] = sum over rows of group g of u.v restricted to the part
-void dots(i64 n, const double* u, const double* v, const std::int32_t* group, i64 ng,
-          std::vector<double>& out, int nt) {
-    std::fill(out.begin(), out.end(), 0.0);
+// Row reductions: fn(row, vals) adds row's contributions vals[k][part] (k < K quantities,
+// part 0: h, part 1: z) and may write that row's entries of the work vectors.  out[(k ng +
+// g) 2 + part] receives the sums per group g.  One group: fixed chunks in parallel, then a
+// serial sum over the chunks (the same bits for any thread count); several: one serial pass.
+template <int K, class RowFn>
+void reduce_rows(i64 n, const std::int32_t* group, i64 ng, int nt, std::vector<double>& out, RowFn fn) {
+    out.assign((size_t)K * ng * 2, 0.0);
     if (ng == 1) {
         const i64 nch = (n + CHUNK - 1) / CHUNK;
-        std::vector<double> part((size_t)std::max<i64>(nch, 1) * 2, 0.0);
+        std::vector<double> part((size_t)std::max<i64>(nch, 1) * K * 2, 0.0);
 #ifdef IGL_HHJ_OPENMP
 #pragma omp parallel for schedule(static) num_threads(nt)
 #endif
         for (i64 c = 0; c < nch; ++c) {
-            double s0 = 0.0, s1 = 0.0;
+            double acc[K][2] = {};
             for (i64 r = c * CHUNK; r < std::min(n, (c + 1) * CHUNK); ++r) {
-                s0 += u[3 * r] * v[3 * r];
-                s1 += u[3 * r + 1] * v[3 * r + 1] + u[3 * r + 2] * v[3 * r + 2];
+                double v[K][2] = {};
+                fn(r, v);
+                for (int k = 0; k < K; ++k) { acc[k][0] += v[k][0]; acc[k][1] += v[k][1]; }
             }
-            part[2 * c] = s0; part[2 * c + 1] = s1;
+            for (int k = 0; k < K; ++k) { part[(c * K + k) * 2] = acc[k][0]; part[(c * K + k) * 2 + 1] = acc[k][1]; }
         }
-        for (i64 c = 0; c < nch; ++c) { out[0] += part[2 * c]; out[1] += part[2 * c + 1]; }
+        for (i64 c = 0; c < nch; ++c)
+            for (int k = 0; k < K; ++k) { out[2 * k] += part[(c * K + k) * 2]; out[2 * k + 1] += part[(c * K + k) * 2 + 1]; }
         return;
     }
     for (i64 r = 0; r < n; ++r) {
+        double v[K][2] = {};
+        fn(r, v);
         const i64 g = group[r];
-        out[2 * g] += u[3 * r] * v[3 * r];
-        out[2 * g + 1] += u[3 * r + 1] * v[3 * r + 1] + u[3 * r + 2] * v[3 * r + 2];
+        for (int k = 0; k < K; ++k) { out[(k * ng + g) * 2] += v[k][0]; out[(k * ng + g) * 2 + 1] += v[k][1]; }
     }
 }
 
-// Solve A x = b (x0 = 0), Jacobi-preconditioned, CG scalars per (group, part).
+// Solve A x = b (x0 = 0), Jacobi-preconditioned, CG scalars per (group, part), three fused
+// sweeps per iteration (A p with p.Ap; the update of x and r with r.r and r.(D^-1 r); p).
 // Returns 0 converged, 1 iteration cap, 3 breakdown (non-positive curvature).
 int pcg_hz(const HZSystem& S, const std::int32_t* group, i64 ng, const double* b, double* x,
            double rtol, i64 maxiter, int nt, i64* its) {
     const i64 n = S.n;
     const size_t n3 = (size_t)n * 3;
     const size_t np = (size_t)ng * 2;
-    std::vector<double> r(b, b + n3), z(n3), p(n3), q(n3);
-    std::vector<double> bb(np), rr(np), rz(np), pq(np), alpha(np), beta(np);
+    const int th = ng == 1 ? nt : 1;
+    std::vector<double> r(b, b + n3), p(n3), q(n3), red;
+    std::vector<double> bb(np), rz(np), alpha(np), beta(np);
     std::vector<unsigned char> done(np, 0);
+    auto gid = [&](i64 row) { return ng == 1 ? (i64)0 : (i64)group[row]; };
     std::fill(x, x + n3, 0.0);
-    auto gp = [&](i64 row, int part) { return 2 * (size_t)(ng == 1 ? 0 : group[row]) + part; };
-    dots(n, b, b, group, ng, bb, nt);
+    // bb = b.b, rz = r.(D^-1 r), p = D^-1 r
+    reduce_rows<2>(n, group, ng, th, red, [&](i64 i, double (&v)[2][2]) {
+        const double d = S.dinv[i];
+        const double* ri = &r[3 * i];
+        double* pi = &p[3 * i];
+        for (int c = 0; c < 3; ++c) pi[c] = d * ri[c];
+        v[0][0] = ri[0] * ri[0]; v[0][1] = ri[1] * ri[1] + ri[2] * ri[2];
+        v[1][0] = d * v[0][0]; v[1][1] = d * v[0][1];
+    });
     bool all = true;
     for (size_t k = 0; k < np; ++k) {
+        bb[k] = red[k];
+        rz[k] = red[np + k];
         done[k] = !(bb[k] > 0.0);
         all = all && done[k];
     }
     *its = 0;
     if (all) return 0;
-    for (size_t s = 0; s < n3; ++s) z[s] = S.dinv[s / 3] * r[s];
-    p = z;
-    dots(n, r.data(), z.data(), group, ng, rz, nt);
     for (i64 it = 1; it <= maxiter; ++it) {
-        apply(S, p.data(), q.data(), nt);
-        dots(n, p.data(), q.data(), group, ng, pq, nt);
+        // q = A p, p.q
+        reduce_rows<1>(n, group, ng, th, red, [&](i64 i, double (&v)[1][2]) {
+            double h = 0.0, zr = 0.0, zi = 0.0;
+            for (i64 e = S.indptr[i]; e < S.indptr[i + 1]; ++e) {
+                const double* pc = &p[3 * (i64)S.indices[e]];
+                const double a = S.a[e], c = a * S.pc[e], s = a * S.ps[e];
+                h += a * pc[0];
+                zr += c * pc[1] - s * pc[2];
+                zi += s * pc[1] + c * pc[2];
+            }
+            double* qi = &q[3 * i];
+            const double* pi = &p[3 * i];
+            qi[0] = h; qi[1] = zr; qi[2] = zi;
+            v[0][0] = pi[0] * h; v[0][1] = pi[1] * zr + pi[2] * zi;
+        });
         for (size_t k = 0; k < np; ++k) {
             if (done[k]) { alpha[k] = 0.0; continue; }
-            if (!(pq[k] > 0.0)) return 3;
-            alpha[k] = rz[k] / pq[k];
+            if (!(red[k] > 0.0)) return 3;
+            alpha[k] = rz[k] / red[k];
         }
-#ifdef IGL_HHJ_OPENMP
-#pragma omp parallel for schedule(static) num_threads(nt)
-#endif
-        for (i64 row = 0; row < n; ++row)
-            for (int c = 0; c < 3; ++c) {
-                const double a = alpha[gp(row, c > 0)];
-                const size_t s = 3 * (size_t)row + c;
-                x[s] += a * p[s];
-                r[s] -= a * q[s];
-            }
-        dots(n, r.data(), r.data(), group, ng, rr, nt);
+        // x += alpha p, r -= alpha q; r.r and r.(D^-1 r)
+        reduce_rows<2>(n, group, ng, th, red, [&](i64 i, double (&v)[2][2]) {
+            const i64 g = gid(i);
+            const double a0 = alpha[2 * g], a1 = alpha[2 * g + 1], d = S.dinv[i];
+            double* xi = x + 3 * i;
+            double* ri = &r[3 * i];
+            const double* pi = &p[3 * i];
+            const double* qi = &q[3 * i];
+            xi[0] += a0 * pi[0]; ri[0] -= a0 * qi[0];
+            xi[1] += a1 * pi[1]; ri[1] -= a1 * qi[1];
+            xi[2] += a1 * pi[2]; ri[2] -= a1 * qi[2];
+            v[0][0] = ri[0] * ri[0]; v[0][1] = ri[1] * ri[1] + ri[2] * ri[2];
+            v[1][0] = d * v[0][0]; v[1][1] = d * v[0][1];
+        });
         all = true;
         for (size_t k = 0; k < np; ++k) {
-            if (!done[k] && rr[k] <= rtol * rtol * bb[k]) done[k] = 1;
+            if (!done[k] && red[k] <= rtol * rtol * bb[k]) done[k] = 1;
             all = all && done[k];
+            beta[k] = done[k] ? 0.0 : red[np + k] / rz[k];
+            if (!done[k]) rz[k] = red[np + k];
         }
         *its = it;
         if (all) return 0;
-        for (size_t s = 0; s < n3; ++s) z[s] = S.dinv[s / 3] * r[s];
-        std::vector<double> rz_new(np);
-        dots(n, r.data(), z.data(), group, ng, rz_new, nt);
-        for (size_t k = 0; k < np; ++k) {
-            beta[k] = done[k] ? 0.0 : rz_new[k] / rz[k];
-            if (!done[k]) rz[k] = rz_new[k];
-        }
+        // p = D^-1 r + beta p (frozen pairs keep their p)
 #ifdef IGL_HHJ_OPENMP
-#pragma omp parallel for schedule(static) num_threads(nt)
+#pragma omp parallel for schedule(static) num_threads(th)
 #endif
-        for (i64 row = 0; row < n; ++row)
-            for (int c = 0; c < 3; ++c) {
-                const size_t k = gp(row, c > 0);
-                if (done[k]) continue;
-                const size_t s = 3 * (size_t)row + c;
-                p[s] = z[s] + beta[k] * p[s];
+        for (i64 i = 0; i < n; ++i) {
+            const i64 g = gid(i);
+            const double d = S.dinv[i];
+            if (!done[2 * g]) p[3 * i] = d * r[3 * i] + beta[2 * g] * p[3 * i];
+            if (!done[2 * g + 1]) {
+                p[3 * i + 1] = d * r[3 * i + 1] + beta[2 * g + 1] * p[3 * i + 1];
+                p[3 * i + 2] = d * r[3 * i + 2] + beta[2 * g + 1] * p[3 * i + 2];
             }
+        }
     }
     return 1;
 }
