@@ -49,6 +49,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .curvature import check_principal_curvature_args, vertex_principal_curvature
+from .solvers import DEFAULT_RTOL
 from .mesh import as_mesh, mark_bad_vertices
 
 __all__ = [
@@ -139,15 +140,14 @@ def hhj_vertex(V, F=None, *, shape_operator=None, radius=5, **kwargs):
     -------
     CurvatureEstimate, location "vertex": k1, k2, H = (k1+k2)/2, K = k1 k2, d1, d2.
     """
-    from .curvature import principal_curvature, vertex_principal_curvature, vertex_shape_operator
+    from .curvature import dropin_vertex_values, principal_curvature
     if shape_operator is None:
         PD1, PD2, PV1, PV2, bad = principal_curvature(V, F, radius, **kwargs)
     else:
         mesh = as_mesh(V, F)
-        Sv, N = vertex_shape_operator(mesh, _given_shape_operator(mesh, shape_operator, kwargs),
-                                      smoothing=radius)
-        PD1, PD2, PV1, PV2 = vertex_principal_curvature(mesh, Sv, N)
-        PD1, PD2, PV1, PV2, bad = mark_bad_vertices(mesh, PD1, PD2, PV1, PV2)
+        PD1, PD2, PV1, PV2, bad = dropin_vertex_values(
+            mesh, _given_shape_operator(mesh, shape_operator, kwargs), radius,
+            kwargs.get("rtol", DEFAULT_RTOL))
     return _ordered("hhj_vertex", "vertex", PV1, PV2, 0.5 * (PV1 + PV2), PV1 * PV2, PD1, PD2, bad)
 
 

@@ -43,8 +43,10 @@ def solve_groups(mesh: TriangleMesh, solver):
     edge_count = np.bincount(labels[mesh.edges[:, 0]], minlength=n)
     small = edge_count <= AUTO_DIRECT_MAX if solver == "auto" else np.zeros(n, dtype=bool)
     big = np.flatnonzero(~small)
-    if len(big) == 0 or (len(big) == 1 and not small.any()):
-        return None                # all small (one direct solve) or a single component
+    if len(big) == 1 and not small.any():
+        return None                # a single component
+    if len(big) == 0:              # all small: one direct solve (auto could pick CG for the total)
+        return [(np.arange(mesh.n_faces), "direct")]
     order = np.argsort(face_label, kind="stable")
     starts = np.searchsorted(face_label[order], np.arange(n + 1))
     groups = [(np.sort(order[starts[c]:starts[c + 1]]), solver) for c in big]

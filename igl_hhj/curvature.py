@@ -27,6 +27,7 @@ __all__ = [
     "face_principal_curvature", "face_mean_curvature", "face_gaussian_curvature",
     "principal_from_shape_operator", "vertex_shape_operator", "vertex_principal_curvature",
     "check_principal_curvature_args", "boundary_treatment", "smoothed_face_shape_operator",
+    "dropin_vertex_values",
 ]
 
 
@@ -206,6 +207,8 @@ def _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supp
         groups = _components.solve_groups(mesh, solver)
     if groups is None:
         return _shape_operator_one(mesh, *data, solver, rtol, info, estimated)
+    if len(groups) == 1:              # every component small: one direct solve of the mesh
+        return _shape_operator_one(mesh, *data, groups[0][1], rtol, info, estimated)
     S = np.empty((mesh.n_faces, 3, 3))
     for faces, group_solver in groups:
         sub, verts = _components.submesh(mesh, faces)
@@ -701,8 +704,26 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
     rtol = _check_rtol(rtol)
     S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver,
                         rtol, estimated=treatment == "estimate")
-    X, N = _intrinsic.vertex_stage(mesh, S, radius, rtol=rtol)
+    holder = [S]     # the only reference: the vertex stage frees S before smoothing
     del S
+    return dropin_vertex_values(mesh, holder, radius, rtol)
+
+
+def dropin_vertex_values(mesh, S, radius, rtol=DEFAULT_RTOL):
+    """The vertex stage of :func:`principal_curvature` on given face tensors ``S`` (#F, 3, 3).
+
+    :func:`igl_hhj.intrinsic.vertex_stage` (intrinsic recovery, adaptive twiced
+    smoothing at scale ``radius``), then ``κ1,2 = H ± |z|`` and the directions
+    (:func:`igl_hhj.kernels.principal_hz`), NaN rows at unreferenced vertices and at
+    vertices without a tangent plane (:func:`igl_hhj.mesh.mark_bad_vertices`).  ``S`` is
+    may be given as a one-element list, emptied after the recovery, so that the face
+    tensors are freed before the smoothing (the call's memory peak).
+
+    Returns
+    -------
+    PD1, PD2 : (#V, 3), PV1, PV2 : (#V,), bad_vertices : list of int (as :func:`principal_curvature`).
+    """
+    X, N = _intrinsic.vertex_stage(mesh, S, radius, rtol=rtol)
     PD1, PD2, PV1, PV2 = kernels.principal_hz(X, N)
     del X
     ref = mesh.referenced_vertices

@@ -334,10 +334,16 @@ def vertex_stage_reference(mesh: TriangleMesh, S, radius, *, normals=None, weigh
     w = recovery_weights(mesh) if weights is None else weights
     X = recover(mesh, S, N, w)
     if radius > 0:
-        pilot = smooth(mesh, X, N, w, PILOT_RADIUS, steps=1, order=1)
-        r = adaptive_radius(mesh, pilot, roughness(mesh, S, N, X), radius)
-        X = smooth(mesh, X, N, w, radius, times=smoothing_times(mesh, r))
+        X = _smooth_reference(mesh, X, N, w, roughness(mesh, S, N, X), radius)
     return X, N
+
+
+def _smooth_reference(mesh, X, N, w, rough, radius):
+    """Pilot, adaptive radius and twiced smoothing by sparse LU (the reference and the
+    fallback of :func:`vertex_stage`)."""
+    pilot = smooth(mesh, X, N, w, PILOT_RADIUS, steps=1, order=1)
+    r = adaptive_radius(mesh, pilot, rough, radius)
+    return smooth(mesh, X, N, w, radius, times=smoothing_times(mesh, r))
 
 
 def smoothing_rtol(rtol):
@@ -357,7 +363,9 @@ def vertex_stage(mesh: TriangleMesh, S, radius, *, rtol=None, maxiter=500, info=
 
     Parameters
     ----------
-    S : (#F, 3, 3) tangential face tensors (Walker's S_h).
+    S : (#F, 3, 3) tangential face tensors (Walker's S_h), or a one-element list holding
+        them, which is emptied after the recovery (so that the tensors can be freed
+        before the smoothing, the memory peak of the drop-in).
     radius : float ≥ 0, smoothing scale in rings (0: recovery only).
     rtol : float, the caller's tolerance (default :data:`igl_hhj.solvers.DEFAULT_RTOL`);
         every smoothing solve runs to the relative residual :func:`smoothing_rtol` of it.
@@ -375,7 +383,11 @@ def vertex_stage(mesh: TriangleMesh, S, radius, *, rtol=None, maxiter=500, info=
     rtol = DEFAULT_RTOL if rtol is None else rtol
     N = mesh.vertex_normals
     w = kernels.recovery_weights(mesh, QUALITY_FLOOR)
-    X, rough = kernels.intrinsic_patch_recovery(mesh, S, N, w)
+    if isinstance(S, list):
+        X, rough = kernels.intrinsic_patch_recovery(mesh, S.pop(), N, w)
+    else:
+        X, rough = kernels.intrinsic_patch_recovery(mesh, S, N, w)
+    del S
     if not radius > 0:
         return X, N
     srtol = smoothing_rtol(rtol)
@@ -389,5 +401,5 @@ def vertex_stage(mesh: TriangleMesh, S, radius, *, rtol=None, maxiter=500, info=
     if info is not None:
         info.update(smoothing_iterations=its, components=ncomp, radius_median=float(np.median(r)))
     if status != 0:          # a solve stalled (X unchanged): the direct reference
-        X = vertex_stage_reference(mesh, S, radius, normals=N, weights=w)[0]
+        X = _smooth_reference(mesh, X0, N, w, rough, radius)
     return X, N

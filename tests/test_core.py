@@ -293,12 +293,13 @@ def _vertex_stage_meshes():
 @pytest.mark.parametrize("name", ["closed", "open", "sliver", "unreferenced"])
 @pytest.mark.parametrize("smoothing", [0, 2, 5])
 def test_vertex_stage_equals_numpy_reference(name, smoothing):
-    """The compiled patch recovery + smoothing (recovery.recover_and_smooth) equals the numpy
-    reference (recover_vertex_tensors + smooth_vertex_tensors), NaN rows included."""
+    """The compiled ambient patch recovery + smoothing (recovery.recover_and_smooth) equals
+    the numpy reference (recover_vertex_tensors + smooth_vertex_tensors), NaN rows included.
+    (The drop-in's intrinsic stage: tests/test_intrinsic.py.)"""
     from igl_hhj.curvature import _vertex_shape_operator_numpy, vertex_shape_operator
     m = TriangleMesh(*_vertex_stage_meshes()[name])
     S = _shape_operator(m, None, None, None, "direct")
-    Sv, N = vertex_shape_operator(m, S, smoothing=smoothing)
+    Sv, N = vertex_shape_operator(m, S, smoothing=smoothing, recovery="patch")
     Sr, Nr = _vertex_shape_operator_numpy(m, S, smoothing=smoothing)
     ref = m.referenced_vertices
     assert np.array_equal(np.isnan(Sv).any(axis=(1, 2)), ~ref)
@@ -664,15 +665,15 @@ def test_large_call_heap_does_not_change_results(monkeypatch):
 
 
 def test_dropin_frees_the_face_tensors_before_its_memory_peak(monkeypatch):
-    """The drop-in frees the (#F, 3, 3) face tensors after the patch recovery, before the
+    """The drop-in frees the (#F, 3, 3) face tensors after the recovery, before the
     smoothing (its memory peak), and gives the same values as the public composition."""
     import weakref
 
-    from igl_hhj import curvature, recovery
+    from igl_hhj import curvature
     V, F = icosphere(4)
     V = jitter_tangentially(V, F, Sphere(), 0.3, seed=1)
     alive = {}
-    real_S, real_smooth = curvature._shape_operator, recovery.smooth_recovered
+    real_S, real_smooth = curvature._shape_operator, kernels.intrinsic_smoothing
 
     def shape_operator(*a, **k):
         S = real_S(*a, **k)
@@ -683,12 +684,11 @@ def test_dropin_frees_the_face_tensors_before_its_memory_peak(monkeypatch):
         alive["at smoothing"] = alive["S"]() is not None
         return real_smooth(*a, **k)
     monkeypatch.setattr(curvature, "_shape_operator", shape_operator)
-    monkeypatch.setattr(recovery, "smooth_recovered", smooth)
+    monkeypatch.setattr(kernels, "intrinsic_smoothing", smooth)
     out = igl_hhj.principal_curvature(V, F)
     assert alive["at smoothing"] is False
     monkeypatch.undo()
     m = TriangleMesh(V, F)
-    Sv, N = curvature.vertex_shape_operator(m, igl_hhj.shape_operator(m), smoothing=5)
-    ref = igl_hhj.mesh.mark_bad_vertices(m, *curvature.vertex_principal_curvature(m, Sv, N))
+    ref = curvature.dropin_vertex_values(m, igl_hhj.shape_operator(m), 5)
     for a, b in zip(ref, out):
         np.testing.assert_array_equal(a, b)

@@ -1,0 +1,217 @@
+"""The drop-in's intrinsic vertex stage (igl_hhj.intrinsic, issue 23): compiled kernels
+against the numpy reference, exact invariances, component independence, thin tubes,
+Gauss–Bonnet on the shared real meshes against libigl."""
+from pathlib import Path
+
+import igl
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+import igl_hhj
+from igl_hhj import intrinsic, kernels
+from igl_hhj import recovery as rc
+from igl_hhj.mesh import TriangleMesh
+from igl_hhj.surfaces import Sphere, icosphere, jitter_tangentially
+
+MESHES = Path(__file__).resolve().parents[2] / "shared" / "data" / "meshes"
+
+
+def tube_torus(n_tube, R=1.0, r=0.1, jitter=0.0, seed=0):
+    """Torus with ``n_tube`` vertices around the tube and square-ish faces, outward normals."""
+    n_ring = int(round(n_tube * R / r))
+    u = np.arange(n_ring) * 2 * np.pi / n_ring
+    v = np.arange(n_tube) * 2 * np.pi / n_tube
+    U, W = np.meshgrid(u, v, indexing="ij")
+    if jitter:
+        rng = np.random.default_rng(seed)
+        U = U + jitter * (2 * np.pi / n_ring) * rng.uniform(-1, 1, U.shape)
+        W = W + jitter * (2 * np.pi / n_tube) * rng.uniform(-1, 1, W.shape)
+    X = np.stack([(R + r * np.cos(W)) * np.cos(U), (R + r * np.cos(W)) * np.sin(U), r * np.sin(W)],
+                 axis=-1).reshape(-1, 3)
+    I, J = (a.ravel() for a in np.meshgrid(np.arange(n_ring), np.arange(n_tube), indexing="ij"))
+
+    def idx(i, j):
+        return (i % n_ring) * n_tube + (j % n_tube)
+    a, b, c, d = idx(I, J), idx(I + 1, J), idx(I + 1, J + 1), idx(I, J + 1)
+    return X, np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
+
+
+def voronoi_areas(V, F):
+    return igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal()
+
+
+def rel(a, b):
+    return float(np.abs(a - b).max() / np.abs(b).max())
+
+
+def _meshes():
+    V, F = icosphere(3)
+    Vj = jitter_tangentially(V, F, Sphere(), 0.3, seed=2)
+    keep = V[:, 2] < 0.6                                      # an open cap
+    Fo = F[keep[F].all(axis=1)]
+    used = np.unique(Fo)
+    remap = np.full(len(V), -1)
+    remap[used] = np.arange(len(used))
+    Vu = np.vstack([Vj, [[5.0, 5.0, 5.0]]])                  # an unreferenced vertex
+    Vs = Vj.copy()
+    f = F[0]                                                  # a sliver: pull a corner onto its edge
+    Vs[f[2]] = 0.5 * (Vs[f[0]] + Vs[f[1]]) + 1e-4 * (Vs[f[2]] - 0.5 * (Vs[f[0]] + Vs[f[1]]))
+    return {"closed": (Vj, F), "open": (Vj[used], remap[Fo]), "unreferenced": (Vu, F), "sliver": (Vs, F)}
+
+
+@pytest.mark.parametrize("name", ["closed", "open", "unreferenced", "sliver"])
+def test_compiled_kernels_equal_reference(name):
+    V, F = _meshes()[name]
+    m = TriangleMesh(V, F)
+    S = igl_hhj.shape_operator(m, solver="direct")
+    N = m.vertex_normals
+    w = kernels.recovery_weights(m, rc.QUALITY_FLOOR)
+    X, rough = kernels.intrinsic_patch_recovery(m, S, N, w)
+    Xr = intrinsic.recover(m, S, N, w)
+    assert rel(X, Xr) <= 1e-12
+    assert rel(rough, intrinsic.roughness(m, S, N, Xr)) <= 1e-10
+    e1, e2 = intrinsic.vertex_frames(N)
+    ph = np.stack(intrinsic.transport_phase_components(m, N, e1, e2), axis=1)
+    assert np.abs(kernels.transport_phases(m, N) - ph).max() <= 1e-14
+    pilot = intrinsic.smooth(m, Xr, N, w, 5, steps=1, order=1)
+    np.testing.assert_allclose(kernels.adaptive_radius(m, pilot, rough, 5, intrinsic.ADAPTIVE_GAIN,
+                                                       intrinsic.ADAPTIVE_POWER, *intrinsic.ADAPTIVE_RANGE),
+                               intrinsic.adaptive_radius(m, pilot, rough, 5), rtol=1e-12)
+    Xc, _ = intrinsic.vertex_stage(m, S, 5, rtol=1e-20)      # smoothing to 1e-10
+    Xref, _ = intrinsic.vertex_stage_reference(m, S, 5)
+    assert rel(Xc, Xref) <= 1e-7
+    PD1, PD2, PV1, PV2 = kernels.principal_hz(Xc, N)
+    R1, R2, Q1, Q2 = intrinsic.principal(Xc, N)
+    ref = m.referenced_vertices
+    for a, b in ((PD1, R1), (PD2, R2), (PV1, Q1), (PV2, Q2)):
+        assert rel(a[ref], b[ref]) <= 1e-12
+
+
+def test_transport_is_exact_on_a_cylinder():
+    """Minimal rotations carry the circumferential direction of every face of a tube onto
+    the vertex's own: on a hexagonal prism (60° between neighbouring faces) with the
+    tensor of a unit cylinder on every face, the recovered κ1 = 1, κ2 = 0 to round-off,
+    where the ambient average loses a quarter of κ1."""
+    n = 6
+    t = np.arange(n) * 2 * np.pi / n
+    rings = [np.column_stack([np.cos(t), np.sin(t), np.full(n, 0.5 * k)]) for k in range(5)]
+    V = np.vstack(rings)
+    F = []
+    for k in range(4):
+        for i in range(n):
+            a, b = k * n + i, k * n + (i + 1) % n
+            c, d = (k + 1) * n + i, (k + 1) * n + (i + 1) % n
+            F += [[a, b, c], [b, d, c]] if k % 2 == 0 else [[a, b, d], [a, d, c]]   # planar quads
+    m = TriangleMesh(V, np.array(F))
+    nu = m.face_normals
+    axis = np.array([0.0, 0.0, 1.0])
+    tc = np.cross(axis, nu)
+    S = tc[:, :, None] * tc[:, None, :]                     # κ = 1 around, 0 along
+    X = intrinsic.recover(m, S, m.vertex_normals, rc.recovery_weights(m))
+    _, _, k1, k2 = intrinsic.principal(X, m.vertex_normals)
+    mid = np.arange(n, 4 * n)
+    assert np.abs(k2[mid]).max() < 1e-12 and np.abs(k1[mid] - 1).max() < 1e-12
+    # the ambient average + projection loses a part of it
+    Sv, N = rc.recover_vertex_tensors(m, S, keep_trace=False)
+    _, _, a1, a2 = igl_hhj.curvature.vertex_principal_curvature(m, Sv, N)
+    assert np.abs(a1[mid] - 1).max() > 0.05
+
+
+def _jittered_torus():
+    return tube_torus(20, R=1.0, r=0.4, jitter=0.3)
+
+
+@pytest.mark.parametrize("solver", ["auto", "cg"])
+def test_rigid_motion_scaling_relabelling_orientation(solver):
+    """Results are invariant to ≤ 1e-9 relative with the default tolerance: rotation +
+    translation, uniform scaling (curvature × 1/s), vertex permutation, reversed F."""
+    V, F = _jittered_torus()
+    P = igl_hhj.principal_curvature(V, F, solver=solver)
+    Q = Rotation.from_euler("xyz", [0.3, 1.1, -0.7]).as_matrix()
+    Pr = igl_hhj.principal_curvature(V @ Q.T + [3.0, -1.0, 2.0], F, solver=solver)
+    assert rel(Pr[2], P[2]) <= 1e-9 and rel(Pr[3], P[3]) <= 1e-9
+    dots = np.abs(np.einsum("ij,ij->i", P[0] @ Q.T, Pr[0]))
+    sep = np.abs(P[2] - P[3]) > 1e-3 * np.abs(P[2]).max()   # directions defined away from umbilics
+    assert np.abs(dots[sep] - 1).max() <= 1e-9
+    s = 7.3
+    Ps = igl_hhj.principal_curvature(V * s, F, solver=solver)
+    assert rel(s * Ps[2], P[2]) <= 1e-9
+    perm = np.random.default_rng(0).permutation(len(V))
+    inv = np.argsort(perm)
+    Pp = igl_hhj.principal_curvature(V[perm], inv[F], solver=solver)
+    assert rel(Pp[2][inv], P[2]) <= 1e-9
+    Pf = igl_hhj.principal_curvature(V, F[:, ::-1], solver=solver)
+    assert rel(-Pf[3], P[2]) <= 1e-9 and rel(-Pf[2], P[3]) <= 1e-9
+
+
+@pytest.mark.parametrize("other", ["small", "large"])
+def test_components_do_not_see_each_other(other):
+    """Adding an unconnected component changes nothing on the others (≤ 1e-12 absolute),
+    with the default solver and tolerance."""
+    V1, F1 = _jittered_torus()
+    V2, F2 = icosphere(1) if other == "small" else icosphere(5)
+    V2 = 0.1 * V2 + 10.0
+    for A, B in (((V1, F1), (V2, F2)), ((V2, F2), (V1, F1))):
+        P = igl_hhj.principal_curvature(*A)
+        both = igl_hhj.principal_curvature(np.vstack([A[0], B[0]]), np.vstack([A[1], B[1] + len(A[0])]))
+        n = len(A[0])
+        for j in (2, 3):
+            assert np.abs(both[j][:n] - P[j]).max() <= 1e-12
+
+
+def test_scale_is_local():
+    """Two copies of one mesh at scales 1 and 1/8 in one call: the small one's curvatures are
+    8 × the large one's to round-off (a global mean-edge-length scale would smooth the small
+    copy over 8 × fewer rings)."""
+    V, F = _jittered_torus()
+    both = igl_hhj.principal_curvature(np.vstack([V, V / 8 + 5.0]), np.vstack([F, F + len(V)]))
+    n = len(V)
+    assert rel(both[2][n:] / 8, both[2][:n]) <= 1e-9
+
+
+@pytest.mark.parametrize("n_tube", [8, 12])
+def test_thin_torus(n_tube):
+    """R = 1, r = 0.1 with 8 or 12 vertices around the tube (a finger, a handle): no κ2 bias,
+    no total curvature, and κ1 as good as Walker's face S_h itself."""
+    V, F = tube_torus(n_tube)
+    _, _, k1, k2, bad = igl_hhj.principal_curvature(V, F)
+    assert bad == []
+    # exact: κ1 = 1/r = 10 around the tube, κ2 = cos θ / (R + r cos θ) along it
+    ct = (np.hypot(V[:, 0], V[:, 1]) - 1.0) / 0.1
+    assert abs(np.median(k2)) < 0.2
+    assert np.sqrt(np.mean((k2 - ct / (1.0 + 0.1 * ct)) ** 2)) < 0.2
+    total = float(np.sum(k1 * k2 * voronoi_areas(V, F)))
+    assert abs(total) < 0.5 * 4 * np.pi
+    S = igl_hhj.shape_operator(V, F)
+    face_k1 = np.median(np.linalg.eigvalsh(S)[:, 2])
+    assert abs(np.median(k1) / face_k1 - 1) < 0.02          # the vertex stage adds no bias
+    tol = 0.10 if n_tube >= 12 else 0.15                     # the face S_h: 8.58 for 10 at 8 around
+    assert abs(np.median(k1) - 10.0) < tol * 10.0
+
+
+def _closed_shared_meshes():
+    if not MESHES.is_dir():
+        return []
+    out = []
+    for p in sorted(MESHES.glob("*.off")):
+        V, F = igl.read_triangle_mesh(str(p))
+        if len(igl.boundary_facets(F)[0]) == 0:
+            out.append(p)
+    return out
+
+
+@pytest.mark.skipif(not MESHES.is_dir(), reason="shared meshes not available")
+@pytest.mark.parametrize("path", _closed_shared_meshes(), ids=lambda p: p.name)
+def test_gauss_bonnet_on_real_meshes_not_worse_than_libigl(path):
+    """Σ K_i A_i (Voronoi areas) against 2πχ: the drop-in's error ≤ libigl's at radius 5 and 2."""
+    V, F = igl.read_triangle_mesh(str(path))
+    A = voronoi_areas(V, F)
+    chi = len(V) - len(igl.edges(F)) + len(F)
+
+    def err(P):
+        K = P[2] * P[3]
+        ok = np.isfinite(K)
+        return abs(float(np.sum(K[ok] * A[ok])) - 2 * np.pi * chi)
+    for r in (5, 2):
+        assert err(igl_hhj.principal_curvature(V, F, r)) <= err(igl.principal_curvature(V, F, r))
