@@ -10,31 +10,12 @@ from scipy.spatial.transform import Rotation
 
 import igl_hhj
 from igl_hhj import intrinsic, kernels
+from igl_hhj.benchmarks.vertex_stage import tube_torus
 from igl_hhj import recovery as rc
 from igl_hhj.mesh import TriangleMesh
 from igl_hhj.surfaces import Sphere, icosphere, jitter_tangentially
 
 MESHES = Path(__file__).resolve().parents[2] / "shared" / "data" / "meshes"
-
-
-def tube_torus(n_tube, R=1.0, r=0.1, jitter=0.0, seed=0):
-    """Torus with ``n_tube`` vertices around the tube and square-ish faces, outward normals."""
-    n_ring = int(round(n_tube * R / r))
-    u = np.arange(n_ring) * 2 * np.pi / n_ring
-    v = np.arange(n_tube) * 2 * np.pi / n_tube
-    U, W = np.meshgrid(u, v, indexing="ij")
-    if jitter:
-        rng = np.random.default_rng(seed)
-        U = U + jitter * (2 * np.pi / n_ring) * rng.uniform(-1, 1, U.shape)
-        W = W + jitter * (2 * np.pi / n_tube) * rng.uniform(-1, 1, W.shape)
-    X = np.stack([(R + r * np.cos(W)) * np.cos(U), (R + r * np.cos(W)) * np.sin(U), r * np.sin(W)],
-                 axis=-1).reshape(-1, 3)
-    I, J = (a.ravel() for a in np.meshgrid(np.arange(n_ring), np.arange(n_tube), indexing="ij"))
-
-    def idx(i, j):
-        return (i % n_ring) * n_tube + (j % n_tube)
-    a, b, c, d = idx(I, J), idx(I + 1, J), idx(I + 1, J + 1), idx(I, J + 1)
-    return X, np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
 
 
 def voronoi_areas(V, F):

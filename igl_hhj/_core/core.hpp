@@ -83,6 +83,22 @@ inline void tangent_frame(const double* n, double e1[3], double e2[3]) {
     cross3(n, e1, e2);
 }
 
+// Edge lengths l_i (edge opposite corner i) of face f; returns the face's area.
+inline double face_lengths(const double* V, const i64* F, i64 f, double l[3]) {
+    const double* x[3] = {V + 3 * F[3 * f], V + 3 * F[3 * f + 1], V + 3 * F[3 * f + 2]};
+    for (int i = 0; i < 3; ++i) {
+        const double* a = x[(i + 1) % 3];
+        const double* b = x[(i + 2) % 3];
+        const double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        l[i] = std::sqrt(dot3(d, d));
+    }
+    const double e1[3] = {x[1][0] - x[0][0], x[1][1] - x[0][1], x[1][2] - x[0][2]};
+    const double e2[3] = {x[2][0] - x[0][0], x[2][1] - x[0][1], x[2][2] - x[0][2]};
+    double c[3];
+    cross3(e1, e2, c);
+    return 0.5 * std::sqrt(dot3(c, c));
+}
+
 // out = R x, R the minimal rotation taking unit a to unit b (Rodrigues:
 // R x = c x + k x x + (k.x) k / (1 + c), k = a x b, c = a.b; intrinsic.transport).
 // Returns c; undefined for c = -1 (callers give such pairs no weight).

@@ -239,21 +239,9 @@ void adaptive_radius(const double* V, const i64* F, i64 nF, i64 nV, const double
                      double radius, double gain, double power, double lo, double hi, double* r) {
     std::vector<double> hsum(nV, 0.0), cnt(nV, 0.0), area(nF), hT(nF);
     for (i64 f = 0; f < nF; ++f) {
-        double c[3];
-        const double* x0 = V + 3 * F[3 * f];
-        const double* x1 = V + 3 * F[3 * f + 1];
-        const double* x2 = V + 3 * F[3 * f + 2];
-        const double a[3] = {x1[0] - x0[0], x1[1] - x0[1], x1[2] - x0[2]};
-        const double b[3] = {x2[0] - x0[0], x2[1] - x0[1], x2[2] - x0[2]};
-        cross3(a, b, c);
-        area[f] = 0.5 * std::sqrt(dot3(c, c));
-        double h = 0.0;
-        for (int i = 0; i < 3; ++i) {
-            const double* p = V + 3 * F[3 * f + (i + 1) % 3];
-            const double* q = V + 3 * F[3 * f + (i + 2) % 3];
-            const double d[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
-            h += std::sqrt(dot3(d, d)) / 3.0;
-        }
+        double l[3];
+        area[f] = face_lengths(V, F, f, l);
+        const double h = (l[0] + l[1] + l[2]) / 3.0;
         hT[f] = h;
         for (int k = 0; k < 3; ++k) { hsum[F[3 * f + k]] += h; cnt[F[3 * f + k]] += 1.0; }
     }
@@ -314,13 +302,9 @@ void face_times(const double* V, const i64* F, i64 nF, const double* r, int r_st
 #pragma omp parallel for schedule(static) num_threads(nt)
 #endif
     for (i64 f = 0; f < nF; ++f) {
-        double h = 0.0;
-        for (int i = 0; i < 3; ++i) {
-            const double* p = V + 3 * F[3 * f + (i + 1) % 3];
-            const double* q = V + 3 * F[3 * f + (i + 2) % 3];
-            const double d[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
-            h += std::sqrt(dot3(d, d));
-        }
+        double le[3];
+        face_lengths(V, F, f, le);
+        const double h = le[0] + le[1] + le[2];
         const double l = factor * r[f * r_stride] * (h / 3.0);
         t[f] = l * l / steps;
     }

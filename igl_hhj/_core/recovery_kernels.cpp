@@ -39,17 +39,9 @@ void recovery_weights(const double* V, const i64* F, i64 nF, const i64* FE, cons
 #pragma omp parallel for schedule(static) num_threads(nt)
 #endif
     for (i64 f = 0; f < nF; ++f) {
-        double c[3];
-        face_cross(V, F, f, c);
-        const double area = 0.5 * std::sqrt(dot3(c, c));
-        double l2 = 0.0;
-        for (int i = 0; i < 3; ++i) {
-            const double* a = V + 3 * F[3 * f + (i + 1) % 3];
-            const double* b = V + 3 * F[3 * f + (i + 2) % 3];
-            const double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-            const double l = std::sqrt(dot3(d, d));
-            l2 += l * l;
-        }
+        double l[3];
+        const double area = face_lengths(V, F, f, l);
+        const double l2 = l[0] * l[0] + l[1] * l[1] + l[2] * l[2];
         const double qf = 4.0 * std::sqrt(3.0) * area / l2;
         q[f] = std::isfinite(qf) ? qf : 0.0;
         w[f] = area;
@@ -227,16 +219,9 @@ void intrinsic_patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, con
     std::vector<double> acc((size_t)nV * 3, 0.0);     // sum |T| d^2, sum |T|, sum h_T
     std::vector<i64> cnt(nV, 0);
     for (i64 f = 0; f < nF; ++f) {
-        double c[3];
-        face_cross(V, F, f, c);
-        const double area = 0.5 * std::sqrt(dot3(c, c));
-        double hT = 0.0;
-        for (int i = 0; i < 3; ++i) {
-            const double* a = V + 3 * F[3 * f + (i + 1) % 3];
-            const double* b = V + 3 * F[3 * f + (i + 2) % 3];
-            const double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-            hT += std::sqrt(dot3(d, d)) / 3.0;
-        }
+        double l[3];
+        const double area = face_lengths(V, F, f, l);
+        const double hT = (l[0] + l[1] + l[2]) / 3.0;
         for (int k = 0; k < 3; ++k) {
             const i64 v = F[3 * f + k];
             const double* y = &Y[9 * f + 3 * k];

@@ -46,8 +46,12 @@ def gauss_bonnet(folders, show=True):
     import igl
 
     import igl_hhj
-    paths = [p for d in folders if Path(d).is_dir() for p in sorted(Path(d).iterdir())
-             if p.suffix.lower() in SUFFIXES]
+    paths, seen = [], set()
+    for d in folders:                      # a file name seen in an earlier folder is skipped
+        for p in sorted(Path(d).iterdir()) if Path(d).is_dir() else []:
+            if p.suffix.lower() in SUFFIXES and p.name not in seen:
+                seen.add(p.name)
+                paths.append(p)
     rows = []
     for p in progress(paths, "Gauss-Bonnet", "mesh", show):
         try:
@@ -70,12 +74,17 @@ def gauss_bonnet(folders, show=True):
     return rows
 
 
-def tube_torus(n_tube, R=1.0, r=0.1):
-    """Torus with ``n_tube`` vertices around the tube, square-ish faces, outward normals."""
+def tube_torus(n_tube, R=1.0, r=0.1, jitter=0.0, seed=0):
+    """Torus with ``n_tube`` vertices around the tube, square-ish faces, outward normals;
+    ``jitter``: each vertex moved by up to that fraction of the spacing in both angles."""
     n_ring = int(round(n_tube * R / r))
     u = np.arange(n_ring) * 2 * np.pi / n_ring
     v = np.arange(n_tube) * 2 * np.pi / n_tube
     U, W = np.meshgrid(u, v, indexing="ij")
+    if jitter:
+        rng = np.random.default_rng(seed)
+        U = U + jitter * (2 * np.pi / n_ring) * rng.uniform(-1, 1, U.shape)
+        W = W + jitter * (2 * np.pi / n_tube) * rng.uniform(-1, 1, W.shape)
     X = np.stack([(R + r * np.cos(W)) * np.cos(U), (R + r * np.cos(W)) * np.sin(U), r * np.sin(W)],
                  axis=-1).reshape(-1, 3)
     I, J = (a.ravel() for a in np.meshgrid(np.arange(n_ring), np.arange(n_tube), indexing="ij"))
@@ -112,9 +121,8 @@ def invariance():
 
     import igl_hhj
     from ..surfaces import icosphere
-    V, F = tube_torus(20, r=0.4)
+    V, F = tube_torus(20, r=0.4, jitter=0.3)
     rng = np.random.default_rng(0)
-    V = V + 0.01 * rng.normal(size=V.shape)
     P = igl_hhj.principal_curvature(V, F)
     Q = Rotation.from_euler("xyz", [0.3, 1.1, -0.7]).as_matrix()
 
