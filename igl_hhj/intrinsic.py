@@ -176,21 +176,22 @@ def smoothing_times(mesh: TriangleMesh, radius, steps=SMOOTHING_STEPS):
     return (SMOOTHING_PER_RADIUS * np.asarray(radius, dtype=np.float64) * hT) ** 2 / steps
 
 
-def roughness(mesh: TriangleMesh, S, N, X):
+def roughness(mesh: TriangleMesh, S, N, X, weights):
     """Roughness of the face tensors around each vertex, dimensionless, (#V,).
 
-    ``ρ_v = h_v sqrt(Σ_{T∋v} |T| |Y_T - X_v|² / Σ_{T∋v} |T|)``: the rms distance of the
+    ``ρ_v = h_v sqrt(Σ_{T∋v} w_T |Y_T - X_v|² / Σ_{T∋v} w_T)``: the rms distance of the
     corner components Y_T (:func:`corner_components`) from the recovered value X_v,
-    times the local length h_v (mean over v's corners of the faces' mean edge
-    length).  On a smooth mesh ρ ~ (κh)² (the O(h) discretisation error of S_h, a
+    weighted like the fit (:func:`recover`: the reliability weights, 0 on folded
+    corners, so slivers, whose tensors the fit ignores, do not count as noise), times
+    the local length h_v (mean over v's corners of the faces' mean edge length).  On a smooth mesh ρ ~ (κh)² (the O(h) discretisation error of S_h, a
     few 1e-4 to 1e-2); under normal noise of amplitude s·h it grows like ~3 s
     (measured: 0.029 at s = 0.01, 0.28 at s = 0.1 on the ellipsoid and the torus of
     ``igl_hhj.benchmarks.robustness``).  0 at unreferenced vertices."""
     e1, e2 = vertex_frames(N)
-    Y, _ = corner_components(mesh, S, N, e1, e2)
+    Y, cosine = corner_components(mesh, S, N, e1, e2)
     v = mesh.F.ravel()
     d2 = ((np.where(np.isfinite(Y), Y, 0.0).reshape(-1, 3) - X[v]) ** 2).sum(axis=1)
-    A = np.repeat(mesh.face_areas, 3)
+    A = np.where(cosine > 0, np.asarray(weights, dtype=np.float64)[:, None], 0.0).ravel()
     hT = np.repeat(mesh.edge_lengths.mean(axis=1), 3)
     n = mesh.n_vertices
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -334,7 +335,7 @@ def vertex_stage_reference(mesh: TriangleMesh, S, radius, *, normals=None, weigh
     w = recovery_weights(mesh) if weights is None else weights
     X = recover(mesh, S, N, w)
     if radius > 0:
-        X = _smooth_reference(mesh, X, N, w, roughness(mesh, S, N, X), radius)
+        X = _smooth_reference(mesh, X, N, w, roughness(mesh, S, N, X, w), radius)
     return X, N
 
 

@@ -51,7 +51,7 @@ def test_compiled_kernels_equal_reference(name):
     X, rough = kernels.intrinsic_patch_recovery(m, S, N, w)
     Xr = intrinsic.recover(m, S, N, w)
     assert rel(X, Xr) <= 1e-12
-    assert rel(rough, intrinsic.roughness(m, S, N, Xr)) <= 1e-10
+    assert rel(rough, intrinsic.roughness(m, S, N, Xr, w)) <= 1e-10
     e1, e2 = intrinsic.vertex_frames(N)
     ph = np.stack(intrinsic.transport_phase_components(m, N, e1, e2), axis=1)
     assert np.abs(kernels.transport_phases(m, N) - ph).max() <= 1e-14

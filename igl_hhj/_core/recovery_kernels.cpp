@@ -171,9 +171,9 @@ void patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double*
 // intrinsic_patch_recovery (intrinsic.recover): the corner components (h, Re z, Im z) of
 // R S_T R^T in the frame of v, R the minimal rotation nu_T -> N_v (corner weight w_T
 // where nu_T . N_v > 0, else 0), fitted by patch_fit.  X (#V,3), rows of unreferenced 0.
-// rough (#V,) or nullptr: intrinsic.roughness, h_v sqrt(sum |T| |Y_T - X_v|^2 / sum |T|)
-// over the corners of v, h_v the mean over them of the faces' mean edge lengths (0 at
-// unreferenced vertices).
+// rough (#V,) or nullptr: intrinsic.roughness, h_v sqrt(sum w |Y_T - X_v|^2 / sum w) over
+// the corners of v (w the fit's corner weights), h_v the mean over them of the faces'
+// mean edge lengths (0 where undefined).
 void intrinsic_patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S,
                               const double* N, const double* w, const unsigned char* ref, double h,
                               double* X, double* rough, int nt) {
@@ -220,9 +220,10 @@ void intrinsic_patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, con
     std::vector<i64> cnt(nV, 0);
     for (i64 f = 0; f < nF; ++f) {
         double l[3];
-        const double area = face_lengths(V, F, f, l);
+        face_lengths(V, F, f, l);
         const double hT = (l[0] + l[1] + l[2]) / 3.0;
         for (int k = 0; k < 3; ++k) {
+            const double area = cosine[3 * f + k] > 0 ? w[f] : 0.0;   // the fit's corner weight
             const i64 v = F[3 * f + k];
             const double* y = &Y[9 * f + 3 * k];
             double d2 = 0.0;
