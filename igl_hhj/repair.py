@@ -310,9 +310,16 @@ def _map_kwargs(R, kwargs):
     return kw
 
 
-def _warn(R, exc, what):
+def _warn(R, exc, what, F=None):
+    lost = ""
+    if F is not None:                       # caller vertices whose every face was dropped
+        had = np.zeros(R.n_vertices, dtype=bool)
+        had[np.asarray(F, dtype=np.int64).ravel()] = True
+        had[R.vertex_map] = False
+        if had.any():
+            lost = f"; {int(had.sum())} vertices left without a face (NaN, in bad_vertices)"
     warnings.warn(f"the mesh was repaired before computing {what} (it was refused with: {exc}): "
-                  f"{R.describe()}. Results are mapped back to the caller's rows; NaN rows are "
+                  f"{R.describe()}{lost}. Results are mapped back to the caller's rows; NaN rows are "
                   f"vertices (faces) left without a usable face. Repair the mesh yourself with "
                   f"igl_hhj.repair.repair_mesh to silence this", MeshWarning, stacklevel=5)
 
@@ -333,7 +340,8 @@ def repaired_principal_curvature(fn, exc, V, F, radius, useKring, kwargs):
     repair, compute ``fn`` on the repaired mesh, map back, warn once."""
     if in_repair():
         raise exc
-    R = repair_mesh(*_mesh_arrays(V, F))
+    V, F = _mesh_arrays(V, F)
+    R = repair_mesh(V, F)
     kw = _map_kwargs(R, kwargs)
     if len(R.F):
         PD1, PD2, PV1, PV2, _ = _run_repaired(fn, R.V, R.F, (radius, useKring), kw)
@@ -345,7 +353,7 @@ def repaired_principal_curvature(fn, exc, V, F, radius, useKring, kwargs):
             & np.isfinite(PV1) & np.isfinite(PV2))
     for a in (PD1, PD2, PV1, PV2):
         a[bad] = np.nan
-    _warn(R, exc, "principal curvatures")
+    _warn(R, exc, "principal curvatures", F)
     return PD1, PD2, PV1, PV2, np.flatnonzero(bad).tolist()
 
 
