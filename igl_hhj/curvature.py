@@ -19,7 +19,7 @@ from . import intrinsic as _intrinsic
 from . import recovery as _recovery
 from .boundary_estimation import BOUNDARY_TREATMENTS, estimate_boundary_normals
 from .hhj import HHJProjection, clamped_load
-from .mesh import as_mesh, mark_bad_vertices, per_vertex_array
+from .mesh import MeshDefectError, as_mesh, mark_bad_vertices, per_vertex_array
 from .solvers import DEFAULT_RTOL, HHJSystem
 
 __all__ = [
@@ -281,7 +281,7 @@ def _check_rtol(rtol):
 def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary: str = "estimate",
                    boundary_normals: ArrayLike | None = None,
                    boundary_shape_operator: ArrayLike | None = None, simply_supported: ArrayLike | None = None,
-                   solver: str = "auto", rtol: float = DEFAULT_RTOL) -> NDArray[np.float64]:
+                   solver: str = "auto", rtol: float = DEFAULT_RTOL, repair: bool = False) -> NDArray[np.float64]:
     """Walker's HHJ approximation S_h of the shape operator ∇_Γν, one tensor per face.
 
     Solves ``A s^k = -B X^k + g^k`` for the three coordinate functions
@@ -322,6 +322,13 @@ def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary: str = "estim
         Relative residual of the iterative solve, per coordinate right-hand
         side; the default leaves a solver error far below the O(h)
         discretisation error (see :mod:`igl_hhj.solvers`).
+    repair : bool, default False
+        True: a mesh refused for a repairable defect (non-manifold edges or
+        vertices, duplicate or reversed-duplicate faces, inconsistent
+        orientation, non-orientable patches, degenerate faces, repeated
+        corners) is repaired as in :func:`principal_curvature` (one
+        :class:`~igl_hhj.mesh.MeshWarning`); rows of dropped faces are NaN,
+        in the caller's F order.  False: such meshes raise ``ValueError``.
 
     Returns
     -------
@@ -353,7 +360,16 @@ def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary: str = "estim
     >>> round(float(np.median(np.trace(S, axis1=1, axis2=2))), 2)   # κ1 + κ2 = 2/R
     2.0
     """
-    mesh = as_mesh(V, F)
+    try:
+        mesh = as_mesh(V, F)
+    except MeshDefectError as exc:       # repairable: only on request (issue 24)
+        if not repair:
+            raise
+        from .repair import repaired_shape_operator
+        return repaired_shape_operator(shape_operator, exc, V, F, dict(
+            boundary=boundary, boundary_normals=boundary_normals,
+            boundary_shape_operator=boundary_shape_operator, simply_supported=simply_supported,
+            solver=solver, rtol=rtol))
     boundary_normals, treatment = _resolve_boundary(mesh, boundary, boundary_normals,
                                                     boundary_shape_operator)
     S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver,
@@ -685,6 +701,20 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
         vertices without a tangent plane (two-sided or folded sheets, see
         :func:`igl_hhj.mesh.mark_bad_vertices`).  Empty for a mesh without them.
 
+    Repairs
+    -------
+    Meshes that libigl accepts but the strict functions refuse are repaired
+    (:func:`igl_hhj.repair.repair_mesh`) only after the strict validation has
+    failed: faces with a repeated corner, degenerate or sliver faces and
+    duplicate (also reversed) faces are dropped, non-manifold edges and
+    vertices split, each patch oriented consistently and then to the caller's
+    majority orientation of that patch (so the signs are the caller's), and
+    non-orientable (Möbius) patches removed.  The values are computed on the
+    repaired mesh and mapped back (a split vertex takes its copy with the
+    largest incident area); vertices left without a usable face are NaN and
+    listed in ``bad_vertices``.  One :class:`igl_hhj.mesh.MeshWarning` names
+    what was repaired.  Bad coordinates, shapes or indices still raise.
+
     Positive curvature on a sphere with outward normals, as libigl.
     Examples
     --------
@@ -698,7 +728,14 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
     1.0
     """
     check_principal_curvature_args(radius, useKring)
-    mesh = as_mesh(V, F)
+    try:
+        mesh = as_mesh(V, F)
+    except MeshDefectError as exc:       # repairable defect: repair, compute, map back (issue 24)
+        from .repair import repaired_principal_curvature
+        return repaired_principal_curvature(principal_curvature, exc, V, F, radius, useKring, dict(
+            boundary=boundary, boundary_normals=boundary_normals,
+            boundary_shape_operator=boundary_shape_operator, simply_supported=simply_supported,
+            solver=solver, rtol=rtol))
     boundary_normals, treatment = _resolve_boundary(mesh, boundary, boundary_normals,
                                                     boundary_shape_operator)
     rtol = _check_rtol(rtol)

@@ -49,7 +49,7 @@ import warnings
 
 import numpy as np
 
-__all__ = ["TriangleMesh", "validate_mesh", "as_mesh", "mark_bad_vertices", "MeshWarning",
+__all__ = ["TriangleMesh", "validate_mesh", "as_mesh", "mark_bad_vertices", "MeshWarning", "MeshDefectError",
            "DEGENERATE_AREA_RTOL", "COORDINATE_MAX", "MIN_MESH_SIZE", "topology_reference"]
 
 DEGENERATE_AREA_RTOL = 1e-7
@@ -70,6 +70,19 @@ FOLDED_NORMAL_RTOL = float(np.sqrt(np.finfo(np.float64).eps))
 
 class MeshWarning(UserWarning):
     """An accepted mesh that will probably not give what the user expects (e.g. unwelded)."""
+
+
+class MeshDefectError(ValueError):
+    """A ``ValueError`` for a topological or degenerate-face defect that
+    :func:`igl_hhj.repair.repair_mesh` can repair (the drop-in repairs these).
+
+    ``kind`` is one of ``"repeated corner"``, ``"degenerate"``, ``"non-manifold"``,
+    ``"orientation"``.  Bad coordinates, shapes or indices stay plain ``ValueError``.
+    """
+
+    def __init__(self, message, kind):
+        super().__init__(message)
+        self.kind = kind
 
 
 def zero_area_faces(edge_vectors, double_areas):
@@ -142,8 +155,10 @@ def validate_vertices(V, name="V"):
     return V
 
 
-def validate_faces(F, nV, name="F"):
+def validate_faces(F, nV, name="F", repeated_ok=False):
     """Validate and coerce a face array against ``nV`` vertices.
+
+    ``repeated_ok``: accept faces with a repeated vertex (:mod:`igl_hhj.repair` drops them).
 
     Returns
     -------
@@ -172,11 +187,13 @@ def validate_faces(F, nV, name="F"):
         i = int(np.flatnonzero((F >= nV).any(axis=1))[0])
         raise ValueError(f"{name} has out-of-range vertex indices (#V = {nV}); "
                          f"first at face {i}: {F[i]}")
+    if repeated_ok:
+        return F
     bad = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"{name} has degenerate faces with a repeated vertex; "
-                         f"first at face {i}: {F[i]}")
+        raise MeshDefectError(f"{name} has degenerate faces with a repeated vertex; "
+                              f"first at face {i}: {F[i]}", "repeated corner")
     return F
 
 
@@ -467,14 +484,16 @@ class TriangleMesh:
                     f"F has faces whose area overflows float64; first at face {i}: {self.F[i]}"
                     f"{many}. Rescale the mesh (curvature scales as 1/length)")
             if area == 0.0:
-                raise ValueError(
+                raise MeshDefectError(
                     f"F has degenerate (zero-area) faces; first at face {i}: {self.F[i]}{many} "
-                    f"(collinear corners, longest edge {longest:.3g}): remove or collapse them")
-            raise ValueError(
+                    f"(collinear corners, longest edge {longest:.3g}): remove or collapse them",
+                    "degenerate")
+            raise MeshDefectError(
                 f"F has near-degenerate (sliver) faces; first at face {i}: {self.F[i]}{many} "
                 f"(area {area:.3g}, longest edge {longest:.3g}: relative area "
                 f"{2 * area / longest ** 2:.2g} ≤ {DEGENERATE_AREA_RTOL:g}, below what libigl's "
-                f"edge-length formulas resolve): collapse the short edge or remove the sliver")
+                f"edge-length formulas resolve): collapse the short edge or remove the sliver",
+                "degenerate")
         h = float(np.sqrt(l2max.max()))
         if h < MIN_MESH_SIZE:
             raise ValueError(f"the mesh is too small: its longest edge is {h:.3g} < "
@@ -486,9 +505,10 @@ class TriangleMesh:
         bad = count > 2
         if bad.any():
             e = int(np.flatnonzero(bad)[0])
-            raise ValueError(
+            raise MeshDefectError(
                 f"mesh has non-manifold edges (more than two incident faces); first is edge "
-                f"{e} between vertices {self.edges[e].tolist()} with {int(count[e])} faces")
+                f"{e} between vertices {self.edges[e].tolist()} with {int(count[e])} faces",
+                "non-manifold")
         # On a consistently oriented manifold every interior edge is traversed
         # once in each direction.
         pos = np.bincount(self.face_edges.ravel(), weights=self.face_edge_sign.ravel() > 0,
@@ -497,10 +517,11 @@ class TriangleMesh:
         if bad.any():
             e = int(np.flatnonzero(bad)[0])
             f = np.flatnonzero((self.face_edges == e).any(axis=1))
-            raise ValueError(
+            raise MeshDefectError(
                 f"mesh is not consistently oriented: faces {f.tolist()} traverse edge {e} "
                 f"(vertices {self.edges[e].tolist()}) in the same direction; orient it with "
-                f"igl.bfs_orient(F) (a non-orientable surface such as a Möbius band cannot be)")
+                f"igl.bfs_orient(F) (a non-orientable surface such as a Möbius band cannot be)",
+                "orientation")
 
     def _warn_unwelded(self):
         """Warn when boundary vertices coincide (a triangle soup or split seams)."""

@@ -13,6 +13,7 @@ inputs tried is counted in ``FUZZ_COUNTS`` and printed in pytest's summary.
 import collections
 import struct
 import sys
+import warnings
 
 import igl
 import numpy as np
@@ -23,7 +24,7 @@ from hypothesis import strategies as st
 
 import igl_hhj
 from igl_hhj import cli
-from igl_hhj.mesh import DEGENERATE_AREA_RTOL, TriangleMesh
+from igl_hhj.mesh import DEGENERATE_AREA_RTOL, MeshWarning, TriangleMesh
 from igl_hhj.surfaces import icosphere
 from igl_hhj.surfaces.meshing import square_grid
 
@@ -112,17 +113,24 @@ def large_grid():
 def test_slivers_at_the_threshold_on_a_large_mesh(large_grid, seed, log_rel):
     """> 50k edges (solver='auto' takes the face-Schwarz PCG path), one sliver of
     relative area DEGENERATE_AREA_RTOL × 10^log_rel (from below to far above the
-    validation threshold): rejected with a message, or finite output (one solve
-    per example: the drop-in, whose rows come from S_h)."""
+    validation threshold): the strict shape operator rejects it with a message below
+    the threshold, the drop-in then drops the sliver (one MeshWarning, issue 24) and
+    gives finite output (one solve per example: the drop-in, whose rows come from S_h)."""
     V, F = large_grid
     f = int(np.random.default_rng(seed).integers(len(F)))
     FUZZ_COUNTS["slivers (> 50k edges)"] += 1
+    Vs = _sliver(V, F, f, DEGENERATE_AREA_RTOL * 10.0 ** log_rel)
     try:
-        PD1, PD2, PV1, PV2, bad = igl_hhj.principal_curvature(
-            _sliver(V, F, f, DEGENERATE_AREA_RTOL * 10.0 ** log_rel), F)
+        TriangleMesh(Vs, F)
+        rejected = False
     except ValueError as exc:
         assert "near-degenerate" in str(exc) and log_rel < 0.01
-        return
+        rejected = True
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        PD1, PD2, PV1, PV2, bad = igl_hhj.principal_curvature(Vs, F)
+    repaired = [w for w in rec if issubclass(w.category, MeshWarning)]
+    assert len(repaired) == int(rejected)
     assert bad == [] and np.isfinite(np.column_stack([PD1, PD2, PV1, PV2])).all()
 
 
