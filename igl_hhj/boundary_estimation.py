@@ -149,7 +149,8 @@ def estimate_boundary_normals(mesh: TriangleMesh, rings=3):
     for col_ in (0, 1):
         np.add.at(full, e[be, col_], fn)
     Nf = full[verts]
-    Nf /= np.linalg.norm(Nf, axis=1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):   # cancelling normals: NaN, unusable
+        Nf /= np.linalg.norm(Nf, axis=1, keepdims=True)
     out[verts] = N
     # every boundary face must see its vertices' normals on its own side
     for col_ in (0, 1):
