@@ -220,9 +220,10 @@ def adaptive_radius(mesh: TriangleMesh, X_pilot, rough, radius):
     ~ℓ⁴|∇⁴κ| ~ (κh)⁵ L⁴/h, whose minimum is at ``L ∝ ρ^{1/5}/(κh)`` (the exponent
     1/4 and the gain were fitted on the clean, jittered, flipped and noisy families
     of ``igl_hhj.benchmarks.robustness``; ``python -m igl_hhj.benchmarks.vertex_stage``
-    shows the table).  A smooth mesh gets r ≈ 1–2 × radius/5... at thin features
-    (κh large) the radius shrinks to ``radius · ADAPTIVE_RANGE[0]``; noisy scans
-    get up to ``radius · ADAPTIVE_RANGE[1]``.  Non-finite values count as a = 1."""
+    shows the table).  At the default radius 5, smooth meshes get r ≈ 1–9 (growing
+    slowly under refinement, since ρ/(κh)⁴ ~ (κh)⁻² there), thin features (κh large)
+    ``radius · ADAPTIVE_RANGE[0]`` = 1 ring, noisy scans up to ``radius ·
+    ADAPTIVE_RANGE[1]`` = 25.  Non-finite values count as a = 1."""
     n = mesh.n_vertices
     kappa = np.abs(X_pilot[:, 0]) + np.hypot(X_pilot[:, 1], X_pilot[:, 2])
     hv = np.bincount(mesh.F.ravel(), np.repeat(mesh.edge_lengths.mean(axis=1), 3), n) \
