@@ -17,23 +17,19 @@ bad inputs instead of raising (measured with libigl 2.6.3):
 * an ``.off`` face line claiming 2·10⁹ corners in a 45-byte file: 15.7 GB
   of memory, then ``std::bad_alloc``;
 * an ascii ``.ply`` with a non-numeric token: uninitialised indices;
-* ``.obj`` faces written 0-based: index -1 after libigl's 1-based shift;
-* a UTF-8 byte order mark (BOM): ``.obj`` loses its first line (a vertex; a
-  misleading index error follows), ``.off`` fails with "first line should be OFF".
+* ``.obj`` faces written 0-based: index -1 after libigl's 1-based shift.
 
 :func:`read_mesh` therefore checks existence, regular file, readability and
 extension, then checks *every* count and token of the body before libigl
 sees it, with numpy in bounded chunks (memory O(#lines), time linear in the
 file size): the element counts an ``.off`` / ``.ply`` header declares against
-the lines or bytes that follow, every corner count of an ``.off`` face record
-against the indices it lists (records may continue on the following lines:
-libigl reads OFF faces token by token), that every ascii token that must be a number is
+the lines or bytes that follow, every corner count of an ``.off`` face line
+against the indices it lists, that every ascii token that must be a number is
 one, ``.obj`` faces 1-based, binary ``.ply`` face records triangles, binary
 ``.stl`` sizes ``84 + 50 × count``, ``.mesh`` / ``.msh`` section counts
 against the lines that follow.  It reads with libigl's C++ messages captured
 and raises :class:`MeshFileError` (a ``ValueError``) with one line naming the
-problem.  An ``.obj`` / ``.off`` / ``.ply`` file starting with a BOM is checked
-and read as a temporary copy without it (messages name the original file).
+problem.
 
 :func:`write_curvature` writes a
 :class:`igl_hhj.baselines.CurvatureEstimate` as ``.npz``, ``.csv``, ``.ply``
@@ -266,100 +262,23 @@ def _first_bad(path, lines, bad, what):
 
 
 def _check_off_body(path, nV, nF):
-    """Every vertex line numeric, every face record a polygon whose corner count its
-    indices back up (libigl allocates whatever a face record claims).
-
-    libigl's ``readOFF`` reads vertices line by line but faces token by token
-    (``fscanf("%d")``): a face record starts on a new line with its corner count,
-    its indices may continue on the following lines, and whatever follows the last
-    index on its line is skipped (colours).  A ``#`` inside a record makes libigl
-    read garbage, so a record may wrap only across comment-free lines."""
+    """Every vertex line numeric, every face line a polygon whose corner count its
+    indices back up (libigl allocates whatever a face line claims)."""
     L = _Lines(path, 0)
     h = 1 if L.ntok[0] >= 3 else 2                 # counts on the OFF line or the next one
-    if len(L) < h + nV + (1 if nF else 0):
+    if len(L) < h + nV + nF:
         raise MeshFileError(f"{path}: truncated: the header declares {nV} vertices and {nF} "
                             f"faces, the file has {max(len(L) - h, 0)} lines after it")
     v = slice(h, h + nV)
     _check_rows(path, L, v, (L.ntok[v] < 3) | (L.n_num[v] != L.ntok[v]),
                 "vertex line is not three (or more) numbers")
-    f0 = h + nV
-    k = L.first[f0:]
-    single = L.ntok[f0:] >= 1 + k                  # the record fits on its first line
-    if len(k) >= nF and single[:nF].all():         # the common case: one record per line
-        one = np.arange(f0, f0 + nF)
-    else:
-        one = _off_wrapped_records(path, L, f0, nF, k, single)
-    f = np.zeros(len(L), dtype=bool)
-    f[one] = True
-    kk = np.where(f, L.first, 0)
-    _first_bad_if(path, L, f & (kk < 0), "face line does not start with its corner count")
-    _first_bad_if(path, L, f & (kk < 3), "face with fewer than 3 corners")
-    _first_bad_if(path, L, f & (L.int_k != kk), "face corner is not a non-negative integer index")
-
-
-def _first_bad_if(path, L, bad, what):
-    if bad.any():
-        _first_bad(path, L, bad, what)
-
-
-def _off_wrapped_records(path, L, f0, nF, k, single):
-    """Walk the face records of an OFF whose records may span several lines (rows of
-    ``L`` from ``f0``; ``k`` the first token of each row, ``single`` whether the record
-    starting there fits on that row).  Checks every record spanning several rows
-    here and returns the rows of the one-row records (checked by the caller).
-
-    Records start on row starts, so the walk jumps over runs of one-row records;
-    its Python loop runs once per multi-row record."""
-    ntok = L.ntok[f0:]
-    n = len(ntok)
-    cum = np.concatenate([[0], np.cumsum(ntok)])   # tokens before each row
-    multi = np.flatnonzero(~single)
-    one, j, count = [], 0, 0
-    with open(path, "rb") as fh:
-        while count < nF:
-            p = int(np.searchsorted(multi, j))
-            stop = int(multi[p]) if p < len(multi) else n
-            run = min(stop - j, nF - count)
-            if run:
-                one.append(np.arange(f0 + j, f0 + j + run))
-                count, j = count + run, j + run
-            if count == nF:
-                break
-            if j >= n:
-                raise MeshFileError(f"{path}: truncated: the header declares {nF} faces, the file "
-                                    f"has only {count} face record{'' if count == 1 else 's'}")
-            row = f0 + j
-            if k[j] < 0:
-                _first_bad(path, L, np.arange(len(L)) == row,
-                           "face line does not start with its corner count")
-            need = cum[j] + 1 + k[j]
-            if need > cum[-1]:
-                _first_bad(path, L, np.arange(len(L)) == row,
-                           f"face line claims more corners than it lists (truncated or corrupt): "
-                           f"{int(k[j])} corners, the file has {int(cum[-1] - cum[j] - 1)} more values")
-            e = int(np.searchsorted(cum, need, side="left")) - 1     # last row of the record
-            _check_wrapped_record(path, L, fh, row, f0 + e, int(k[j]))
-            count, j = count + 1, e + 1
-    return np.concatenate(one) if one else np.zeros(0, dtype=np.int64)
-
-
-def _check_wrapped_record(path, L, fh, first, last, k):
-    """One face record over rows ``first .. last`` of ``L``: ``k`` ≥ 3 corners, each a
-    non-negative integer, and no comment before its last index."""
-    where = f"{path}: line {int(L.lineno[first])}"
-    if k < 3:
-        raise MeshFileError(f"{where}: face with fewer than 3 corners: {L.text(path, first)!r}")
-    start, end_row = int(L.offset[first]), int(L.offset[last])
-    fh.seek(start)
-    head = fh.read(end_row - start)                       # rows first .. last-1 (and gaps)
-    tail = fh.readline()                                  # row last
-    if b"#" in head:
-        raise MeshFileError(f"{where}: face record continues after a comment (libigl reads "
-                            f"garbage there): {L.text(path, first)!r}")
-    tokens = (head + tail.split(b"#")[0]).split()[1:1 + k]
-    if len(tokens) != k or not all(t.isdigit() for t in tokens):
-        raise MeshFileError(f"{where}: face corner is not a non-negative integer index: "
-                            f"{L.text(path, first)!r}")
+    f = slice(h + nV, h + nV + nF)
+    k = L.first[f]
+    _check_rows(path, L, f, k < 0, "face line does not start with its corner count")
+    _check_rows(path, L, f, k < 3, "face with fewer than 3 corners")
+    _check_rows(path, L, f, L.ntok[f] < 1 + k,
+                "face line claims more corners than it lists (truncated or corrupt)")
+    _check_rows(path, L, f, L.int_k[f] != k, "face corner is not a non-negative integer index")
 
 
 def _check_rows(path, L, rows, bad, what):
@@ -717,55 +636,7 @@ def read_mesh(path):
         which libigl read no faces.
     """
     path, ext, head = _check_input_file(path)
-    if head.startswith(_BOM) and ext in _BOM_EXTENSIONS:
-        with tempfile.TemporaryDirectory(prefix="igl-hhj-") as tmp:
-            return _read_checked(_without_bom(path, Path(tmp)), ext, head[len(_BOM):])
-    return _read_checked(path, ext, head)
-
-
-_BOM = b"\xef\xbb\xbf"
-_BOM_EXTENSIONS = (".obj", ".off", ".ply")
-"""Text formats whose files may start with a UTF-8 byte order mark (editors on Windows
-write one): libigl 2.6's OBJ reader then drops the first line (its first vertex: a
-misleading index error follows) and its OFF reader rejects the header."""
-
-
-class _Stripped(os.PathLike):
-    """A temporary copy of a mesh file without its byte order mark: opened through
-    ``os.fspath`` (the copy), shown in messages as the original file."""
-
-    def __init__(self, original, copy):
-        self.original, self.copy = original, copy
-
-    def __fspath__(self):
-        return str(self.copy)
-
-    def __str__(self):
-        return str(self.original)
-
-    def __format__(self, spec):
-        return format(str(self.original), spec)
-
-
-def _without_bom(path, folder):
-    """Copy ``path`` minus its first 3 bytes (the BOM) into ``folder`` (same file name)."""
-    import shutil
-    copy = folder / path.name
-    try:
-        with open(path, "rb") as src, open(copy, "wb") as dst:
-            src.seek(len(_BOM))
-            shutil.copyfileobj(src, dst, 1 << 20)
-    except OSError as exc:
-        raise MeshFileError(f"{path}: cannot copy it without its UTF-8 byte order mark into "
-                            f"{folder}: {exc.strerror or exc}") from None
-    return _Stripped(path, copy)
-
-
-def _read_checked(path, ext, head):
-    """:func:`read_mesh` after the file checks of :func:`_check_input_file`."""
-    size = os.stat(path).st_size
-    if not head.strip():
-        raise MeshFileError(f"{path}: file is empty")
+    size = path.stat().st_size
     if ext == ".off":
         _check_off_header(path, head, size)
     elif ext == ".ply":
@@ -779,13 +650,10 @@ def _read_checked(path, ext, head):
     import igl
     with CapturedOutput() as cap:
         try:
-            V, F = igl.read_triangle_mesh(os.fspath(path))
+            V, F = igl.read_triangle_mesh(str(path))
             exc = None
         except (RuntimeError, ValueError, MemoryError) as e:
             exc = e
-    if isinstance(path, _Stripped):                # libigl names the copy it read
-        cap.lines = [ln.replace(str(path.copy), str(path)) for ln in cap.lines]
-        exc = exc if exc is None else type(exc)(str(exc).replace(str(path.copy), str(path)))
     if exc is not None:
         raise MeshFileError(f"{path}: libigl could not read it: {exc}{_libigl_says(cap.lines)}")
     V = np.asarray(V, dtype=np.float64)
