@@ -243,6 +243,11 @@ def _curvature(args):
     if not 0 <= args.robust < 50:
         raise UserError(f"--robust must be a percentile in [0, 50), got {args.robust}")
     if args.out is not None:
+        if not str(args.out).strip():
+            raise UserError("-o/--out: empty output path")
+        if os.path.realpath(args.out) == os.path.realpath(args.mesh):
+            raise UserError(f"-o {args.out}: is the input mesh itself; refusing to overwrite it "
+                            f"(choose another output file)")
         _check_writable(args.out)
     if args.screenshot is not None:
         _check_writable(args.screenshot, (".png",))
