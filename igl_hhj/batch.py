@@ -108,6 +108,10 @@ METHOD_LABELS = {"hhj": "HHJ solve", "igl": "libigl quadric fit", "heine": "Hein
 
 
 # --------------------------------------------------------------------------- one mesh
+MAX_RADIUS = 10**6
+"""Largest ``--radius`` (as :func:`igl_hhj.curvature.check_principal_curvature_args`)."""
+
+
 def check_curvature_options(method, per, radius=None):
     """Raise ``ValueError`` for a combination ``igl-hhj curvature`` / ``batch`` cannot compute.
 
@@ -130,6 +134,8 @@ def check_curvature_options(method, per, radius=None):
         if radius < 0 or (radius == 0 and not (method == "hhj" and per == "face")):
             raise ValueError(f"--radius must be a positive integer (0 only with --per face), "
                              f"got {radius}")
+        if radius > MAX_RADIUS:
+            raise ValueError(f"--radius must be at most {MAX_RADIUS} (10**6), got {radius:.3g}")
 
 
 def default_radius(method, per):

@@ -496,8 +496,8 @@ def smoothed_face_shape_operator(mesh, S, smoothing):
 def _check_smoothing(x, name):
     if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, float, np.integer, np.floating)):
         raise TypeError(f"{name} must be a number, got {type(x).__name__}")
-    if not (np.isfinite(x) and x >= 0):
-        raise ValueError(f"{name} must be finite and >= 0, got {x}")
+    if not 0 <= x <= 10**6:                 # also NaN, inf and ints beyond float64
+        raise ValueError(f"{name} must be finite, >= 0 and <= 10**6, got {x:.3g}")
 
 
 def face_mean_curvature(V: Any, F: ArrayLike | None = None, **boundary: Any) -> NDArray[np.float64]:
@@ -520,6 +520,8 @@ def check_principal_curvature_args(radius, useKring):
         raise TypeError(f"radius must be an int (as in igl.principal_curvature), got {type(radius).__name__}")
     if not radius > 0:
         raise ValueError(f"radius must be positive, got {radius}")
+    if radius > 10**6:      # a smoothing scale / k-ring beyond any mesh; 10**300 overflowed
+        raise ValueError(f"radius must be <= 10**6 (a smoothing scale in rings), got {radius:.3g}")
     if not isinstance(useKring, (bool, np.bool_)):
         raise TypeError(f"useKring must be a bool (as in igl.principal_curvature), got {type(useKring).__name__}")
 

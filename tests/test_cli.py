@@ -599,3 +599,11 @@ def test_empty_output_path_is_a_usage_error(sphere, capsys):
     path, _, _ = sphere
     assert cli.main(["curvature", str(path), "-o", ""]) == 2
     assert "empty output path" in one_error_line(capsys.readouterr().err)
+
+
+@pytest.mark.parametrize("extra", [[], ["--method", "igl"], ["--per", "face"]])
+def test_huge_radius_is_a_usage_error(sphere, capsys, extra):
+    """--radius 10**300 used to exit 70 (internal error: OverflowError)."""
+    path, _, _ = sphere
+    assert cli.main(["curvature", str(path), "--radius", str(10**300)] + extra) == 2
+    assert "--radius must be at most 1000000" in one_error_line(capsys.readouterr().err)

@@ -272,3 +272,16 @@ def test_interior_data_rows_may_be_nan():
     N[~m.boundary_vertices] = np.nan
     S = igl_hhj.shape_operator(V, F, boundary_normals=N)
     assert np.isfinite(S).all()
+
+
+def test_huge_radius_is_one_value_error():
+    """radius=10**300 used to raise OverflowError (smoothing: TypeError from np.isfinite)."""
+    from igl_hhj.surfaces import icosphere
+    V, F = icosphere(1)
+    for big in (10**300, 10**6 + 1):
+        with pytest.raises(ValueError, match=r"radius must be <= 10\*\*6"):
+            igl_hhj.principal_curvature(V, F, radius=big)
+        with pytest.raises(ValueError, match=r"smoothing must be .*<= 10\*\*6"):
+            igl_hhj.face_principal_curvature(V, F, smoothing=big)
+    with pytest.raises(ValueError, match="smoothing must be"):
+        igl_hhj.face_principal_curvature(V, F, smoothing=float("nan"))
