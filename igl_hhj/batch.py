@@ -109,6 +109,8 @@ METHOD_LABELS = {"hhj": "HHJ solve", "igl": "libigl quadric fit", "heine": "Hein
 
 # --------------------------------------------------------------------------- one mesh
 MAX_RADIUS = 10**6
+MAX_WORKERS = 256
+"""Largest ``workers`` of the embedded cluster (each is a process)."""
 """Largest ``--radius`` (as :func:`igl_hhj.curvature.check_principal_curvature_args`)."""
 
 
@@ -503,9 +505,9 @@ def plan_jobs(inputs, outdir, fmt="npz"):
     that differ only in extension keep it: ``a/b.off.npz``)."""
     if fmt not in FORMATS:
         raise ValueError(f"unknown format {fmt!r} (use {', '.join(FORMATS)})")
-    out_abs = os.path.abspath(outdir) + os.sep
+    out_abs = os.path.realpath(outdir) + os.sep            # realpath: also through symlinks
     found = [(q, r) for q, r in collect_inputs(inputs)       # outputs are never inputs
-             if not os.path.abspath(q).startswith(out_abs)]
+             if not os.path.realpath(q).startswith(out_abs)]
     if not found:
         return []
     roots = [os.path.abspath(r) for _, r in found]
@@ -846,6 +848,8 @@ def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per
         raise ValueError(f"memory limit must be positive, got {memory_limit}")
     if workers is not None and workers < 0:
         raise ValueError(f"workers must be ≥ 0, got {workers}")
+    if workers is not None and workers > MAX_WORKERS:
+        raise ValueError(f"workers must be at most {MAX_WORKERS} (one process each), got {workers}")
     t0 = time.perf_counter()
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)

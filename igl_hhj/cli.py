@@ -368,6 +368,11 @@ def _batch(args):
     from . import batch
     if args.workers is not None and args.workers < 0:
         raise UserError(f"--workers must be at least 0, got {args.workers}")
+    if args.workers is not None and args.workers > batch.MAX_WORKERS:
+        raise UserError(f"--workers must be at most {batch.MAX_WORKERS} (one process each), "
+                        f"got {args.workers}")
+    if not str(args.out).strip():
+        raise UserError("-o/--out: empty output path")
     try:
         result = batch.run_batch(args.inputs, args.out, scheduler=args.scheduler,
                                  workers=args.workers, method=args.method, per=args.per,

@@ -452,3 +452,34 @@ def test_progress_bar_on_a_terminal(collection, tmp_path):
     text = out.decode(errors="replace")
     assert "2/2" in text and "mesh/s" in text and "failed=1" in text
     assert "[1/2]" not in text                      # no plain lines on a terminal
+
+
+def test_output_folder_through_a_symlink_is_not_read_as_input(tmp_path, capsys):
+    """OUT is a symlink to IN/out: the outputs of the first run used to be inputs of the second."""
+    folder = tmp_path / "in"
+    folder.mkdir()
+    V, F = igl.icosahedron()
+    for i in range(2):
+        igl.write_triangle_mesh(str(folder / f"m{i}.off"), V, F)
+    (folder / "out").mkdir()
+    link = tmp_path / "link"
+    link.symlink_to(folder / "out")
+    for _ in range(2):
+        assert cli.main(["batch", str(folder), "-o", str(link), "--format", "ply",
+                         "--workers", "0", "-q"]) == 0
+        rows = read_summary(link)
+        assert sorted(Path(p).name for p in rows) == ["m0.off", "m1.off"]
+    assert [j.path for j in batch.plan_jobs([folder], link, "ply")] == \
+        [str(folder / "m0.off"), str(folder / "m1.off")]
+
+
+def test_too_many_workers_and_empty_out_are_usage_errors(tmp_path, capsys):
+    V, F = igl.icosahedron()
+    igl.write_triangle_mesh(str(tmp_path / "m.off"), V, F)
+    assert cli.main(["batch", str(tmp_path / "m.off"), "-o", str(tmp_path / "x"),
+                     "--workers", "100000"]) == 2
+    assert "--workers must be at most 256" in capsys.readouterr().err
+    with pytest.raises(ValueError, match="at most 256"):
+        batch.run_batch([tmp_path / "m.off"], tmp_path / "x", workers=100000)
+    assert cli.main(["batch", str(tmp_path / "m.off"), "-o", ""]) == 2
+    assert "empty output path" in capsys.readouterr().err
