@@ -385,6 +385,10 @@ def _batch(args):
         raise UserError(str(exc)) from None
     except OSError as exc:
         raise UserError(f"{args.out}: {exc.strerror or exc}") from None
+    for was, n in result.recomputed.items():
+        print(f"igl-hhj: recomputed {n} mesh{'es' if n > 1 else ''} whose output had {was} "
+              f"(now {batch.describe_options(batch.options_key(args.method, args.per, args.radius))})",
+              file=sys.stderr)
     c = result.counts()
     of = f" of {result.total}" if len(result.rows) < result.total else ""
     print(f"{len(result.rows)}{of} meshes: {c['ok']} ok, {c['error']} error, {c['timeout']} timeout, "

@@ -483,3 +483,52 @@ def test_too_many_workers_and_empty_out_are_usage_errors(tmp_path, capsys):
         batch.run_batch([tmp_path / "m.off"], tmp_path / "x", workers=100000)
     assert cli.main(["batch", str(tmp_path / "m.off"), "-o", ""]) == 2
     assert "empty output path" in capsys.readouterr().err
+
+
+def test_resume_recomputes_when_the_options_change(tmp_path, capsys):
+    """``batch in -o out`` then ``--method igl`` used to skip every mesh and keep HHJ's values."""
+    folder = tmp_path / "in"
+    folder.mkdir()
+    V, F = igl.icosahedron()
+    V, F = igl.upsample(V, F)
+    V = V / np.linalg.norm(V, axis=1, keepdims=True)
+    for i in range(2):
+        igl.write_triangle_mesh(str(folder / f"m{i}.off"), V * (i + 1), F)
+    out = tmp_path / "out"
+
+    def run(*extra):
+        assert cli.main(["batch", str(folder), "-o", str(out), "--workers", "0", "-q", *extra]) == 0
+        err = capsys.readouterr().err
+        return {r["status"] for r in read_summary(out).values()}, err
+
+    assert run()[0] == {"ok"}
+    assert run()[0] == {"skipped"}
+    with np.load(out / "m0.npz") as z:
+        hhj = z["k1"].copy()
+    status, err = run("--method", "igl")
+    assert status == {"ok"}
+    assert "recomputed 2 meshes whose output had --method hhj --per vertex --radius 5" in err
+    assert "(now --method igl --per vertex --radius 5)" in err
+    with np.load(out / "m0.npz") as z:
+        assert not np.allclose(z["k1"], hhj)
+    assert run("--method", "igl") == ({"skipped"}, "")
+    assert run("--method", "igl", "--radius", "3")[0] == {"ok"}
+    assert run("--per", "face")[0] == {"ok"}
+    assert run("--per", "face")[0] == {"skipped"}
+    assert run("--per", "face", "--radius", "0")[0] == {"skipped"}     # 0 is the default per face
+    assert run()[0] == {"ok"}
+    (out / batch.OPTIONS_FILE).unlink()                     # unknown options: recomputed
+    status, err = run()
+    assert status == {"ok"} and "had unknown options" in err
+
+
+def test_pending_options_entry_dates_the_output(tmp_path):
+    """An output being recomputed when the run stopped: newer than the entry → the new options."""
+    out = tmp_path / "o.npz"
+    out.write_bytes(b"x")
+    key = batch.options_key("igl", "vertex", None)
+    mtime = os.stat(out).st_mtime_ns
+    assert batch._made_with({"options": key, "done": False, "t": mtime - 1}, str(out)) == key
+    assert batch._made_with({"options": key, "done": False, "t": mtime + 1}, str(out)) is None
+    assert batch._made_with({"options": key, "done": True, "t": mtime + 1}, str(out)) == key
+    assert batch._made_with(None, str(out)) is None and batch._made_with("junk", str(out)) is None
