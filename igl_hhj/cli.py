@@ -40,7 +40,10 @@ def _interrupted_at_startup(signum, frame):      # Ctrl-C while the imports belo
     os._exit(130)
 
 
-if __name__ == "__main__" or os.path.basename(sys.argv[0] if sys.argv else "") in ("igl-hhj", "cli.py"):
+# not in batch workers: multiprocessing re-runs this module there as __mp_main__ (with the
+# parent's argv) and they inherit SIGINT ignored; each used to print "interrupted" too
+if (__name__ == "__main__" or os.path.basename(sys.argv[0] if sys.argv else "") in ("igl-hhj", "cli.py")) \
+        and __name__ != "__mp_main__" and signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:
     try:
         signal.signal(signal.SIGINT, _interrupted_at_startup)
     except (ValueError, OSError):                # not the main thread
