@@ -105,9 +105,10 @@ def _ordered(name, location, k1, k2, H, K, d1, d2, bad):
         d1 = np.array(d1, dtype=np.float64)
         d2 = np.array(d2, dtype=np.float64)
         d1[swap], d2[swap] = d2[swap], d1[swap].copy()
-    bad = np.unique(np.asarray(bad, dtype=np.int64))
     H = np.array(H, dtype=np.float64)
     K = np.array(K, dtype=np.float64)
+    nan = np.isnan(k1) | np.isnan(k2) | np.isnan(H) | np.isnan(K)   # e.g. cotan H on a zero-area ring
+    bad = np.unique(np.concatenate([np.asarray(bad, dtype=np.int64).ravel(), np.flatnonzero(nan)]))
     for a in (k1, k2, H, K, d1, d2):
         if a is not None:
             a[bad] = np.nan
