@@ -271,3 +271,17 @@ def test_nan_rows_are_listed_in_bad():
         est = B.estimate("libigl_cotan", V, F)
     nan = np.flatnonzero(np.isnan(est.k1) | np.isnan(est.H) | np.isnan(est.K))
     assert nan.size and set(nan) <= set(est.bad)
+
+
+@pytest.mark.parametrize("scale", [1e-50, 1e70])
+def test_pymeshlab_far_scales_are_rescaled(scale):
+    """MeshLab aborted the process (double free) for coordinates scaled 1e-50 / 1e70; the
+    mesh is now handed over at unit size and the curvatures scaled back."""
+    pytest.importorskip("pymeshlab")
+    V, F = icosphere(2)
+    ref = B.estimate("pymeshlab_quadric", V, F)
+    est = B.estimate("pymeshlab_quadric", V * scale, F)
+    np.testing.assert_allclose(est.k1 * scale, ref.k1, rtol=1e-5)
+    np.testing.assert_allclose(est.H * scale, ref.H, rtol=1e-5)
+    np.testing.assert_allclose(est.K * scale ** 2, ref.K, rtol=1e-5)
+    np.testing.assert_allclose(np.abs(np.einsum("ij,ij->i", est.d1, ref.d1)), 1, atol=1e-4)
