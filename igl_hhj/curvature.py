@@ -159,7 +159,10 @@ def _normalised_boundary_normals(mesh, boundary_normals, clamped):
 def _simply_supported_values(mesh, boundary_shape_operator, ss_edges):
     """ρ_e^k = -ν_T^k · mean_e(nᵀ S~ n), eq. (5.18) with P1-interpolated S~. Returns (#E, 3)."""
     S = per_vertex_array(mesh, boundary_shape_operator, "boundary_shape_operator", (3, 3))
-    _data_rows(mesh, S, ss_edges, "boundary_shape_operator")
+    v = _data_rows(mesh, S, ss_edges, "boundary_shape_operator")
+    asym = np.abs(S[v] - S[v].transpose(0, 2, 1)).max(axis=(1, 2)) > 1e-8 * (1 + np.abs(S[v]).max(axis=(1, 2)))
+    if asym.any():                  # a shape operator is symmetric; only nᵀ S n would be used
+        raise ValueError(f"boundary_shape_operator is not symmetric at boundary vertex {int(v[asym][0])}")
     rho = np.zeros((mesh.n_edges, 3))
     e = np.flatnonzero(ss_edges)
     f, n = _boundary_face_and_conormal(mesh, e)
@@ -371,7 +374,7 @@ def surface_hessian(V: Any, F: ArrayLike | None, w: ArrayLike, *, boundary_gradi
         W = per_vertex_array(mesh, w_arr, "w")[:, None]
     else:
         if w_arr.ndim != 2:
-            raise ValueError(f"w must have shape (#V,) or (#V, k), got {w_arr.shape}")
+            raise ValueError("w is required: the (#V,) or (#V, k) vertex values of the function(s) to differentiate" if w is None else f"w must have shape (#V,) or (#V, k), got {w_arr.shape}")
         W = per_vertex_array(mesh, w_arr, "w", (w_arr.shape[1],))
     ref = mesh.referenced_vertices
     if not np.isfinite(W[ref]).all():
