@@ -88,16 +88,16 @@ def mesh_arrays(obj: Any) -> tuple[np.ndarray, np.ndarray] | None:
     if kind == "trimesh":
         return np.asarray(obj.vertices), np.asarray(obj.faces)
     if kind == "pyvista_grid":
-        types = np.asarray(obj.celltypes).ravel()
+        vtk_types = np.asarray(obj.celltypes).ravel()
         flat = np.asarray(obj.cells).ravel()
-        if types.size == 0:
+        if vtk_types.size == 0:
             raise ValueError("the pyvista UnstructuredGrid has no cells")
-        if not np.all(types == _VTK_TRIANGLE):
-            names = sorted({_VTK_NAMES.get(int(t), f"VTK type {int(t)}") for t in np.unique(types)
+        if not np.all(vtk_types == _VTK_TRIANGLE):
+            names = sorted({_VTK_NAMES.get(int(t), f"VTK type {int(t)}") for t in np.unique(vtk_types)
                             if t != _VTK_TRIANGLE})
             raise ValueError(f"the pyvista UnstructuredGrid has {', '.join(names)} cells: only triangles "
                              f"are supported (grid.extract_surface().triangulate() first)")
-        if flat.size != 4 * types.size or not np.all(flat[0::4] == 3):
+        if flat.size != 4 * vtk_types.size or not np.all(flat[0::4] == 3):
             raise ValueError("the pyvista UnstructuredGrid's cell connectivity does not match its "
                              "triangle cell types")
         return np.asarray(obj.points), flat.reshape(-1, 4)[:, 1:]
