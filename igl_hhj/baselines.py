@@ -106,9 +106,10 @@ def _ordered(name, location, k1, k2, H, K, d1, d2, bad):
         d1 = np.array(d1, dtype=np.float64)
         d2 = np.array(d2, dtype=np.float64)
         d1[swap], d2[swap] = d2[swap], d1[swap].copy()
-    bad = np.unique(np.asarray(bad, dtype=np.int64))
     H = np.array(H, dtype=np.float64)
     K = np.array(K, dtype=np.float64)
+    nan = np.isnan(k1) | np.isnan(k2) | np.isnan(H) | np.isnan(K)   # e.g. cotan H on a zero-area ring
+    bad = np.unique(np.concatenate([np.asarray(bad, dtype=np.int64).ravel(), np.flatnonzero(nan)]))
     for a in (k1, k2, H, K, d1, d2):
         if a is not None:
             a[bad] = np.nan
@@ -458,10 +459,18 @@ def pymeshlab_principal_curvature(V, F, method="quadric"):
         raise ValueError(f"unknown pymeshlab method {method!r}; use one of {sorted(PYMESHLAB_METHODS)}")
     mesh = as_mesh(V, F)
     import pymeshlab
+    # MeshLab aborts the process (double free) for coordinates scaled 1e-50 or 1e70: a mesh
+    # whose bounding box is outside [1e-4, 1e4] is seen at unit size and the curvatures are
+    # scaled back (1/s).  Not always: "pca" and "normal_cycles" are not scale-covariant in
+    # MeshLab (absolute-length parameters), so ordinary meshes keep their coordinates.
+    lo, hi = mesh.V.min(axis=0), mesh.V.max(axis=0)
+    size = float(np.max(hi - lo))
+    size = size if np.isfinite(size) and size > 0 and not 1e-4 <= size <= 1e4 else 1.0
+    Vu = (mesh.V - 0.5 * (lo + hi)) / size if size != 1.0 else mesh.V
 
     def run(color):
         ms = pymeshlab.MeshSet()
-        ms.add_mesh(pymeshlab.Mesh(mesh.V, mesh.F.astype(np.int32)))
+        ms.add_mesh(pymeshlab.Mesh(Vu, mesh.F.astype(np.int32)))
         ms.compute_curvature_principal_directions_per_vertex(
             method=PYMESHLAB_METHODS[method], curvcolormethod=color, autoclean=False)
         m = ms.current_mesh()
@@ -475,6 +484,7 @@ def pymeshlab_principal_curvature(V, F, method="quadric"):
     # off), so dir1 is paired with the "Min Curvature" value, then sorted.
     kmax, d1, d2 = run("Min Curvature")
     kmin, _, _ = run("Max Curvature")
+    kmax, kmin = kmax / size, kmin / size          # K = kmax kmin: 1/size² along
     if len(kmax) != mesh.n_vertices:
         raise RuntimeError(f"pymeshlab changed the vertex count ({len(kmax)} != {mesh.n_vertices})")
     n1 = np.linalg.norm(d1, axis=1)

@@ -49,9 +49,11 @@ Resume
 ------
 With ``resume=True`` (default) an input whose output exists and is newer than
 the input is not recomputed (status ``skipped``; its statistics are copied
-from the previous ``summary.csv`` when it has them).  The decision is by
-modification time only: rerun with ``resume=False`` after changing
-``method``, ``per``, ``radius`` or ``format``.
+from the previous ``summary.csv`` when it has them) -- provided it was computed
+with the same ``method``, ``per`` and ``radius``: ``OUTDIR/.igl-hhj-options.json``
+records the options of every output (see :data:`OPTIONS_FILE`); an output
+computed with other options, or of unknown options, is recomputed and
+:attr:`BatchResult.recomputed` says so.
 """
 from __future__ import annotations
 
@@ -108,6 +110,12 @@ METHOD_LABELS = {"hhj": "HHJ solve", "igl": "libigl quadric fit", "heine": "Hein
 
 
 # --------------------------------------------------------------------------- one mesh
+MAX_RADIUS = 10**6
+MAX_WORKERS = 256
+"""Largest ``workers`` of the embedded cluster (each is a process)."""
+"""Largest ``--radius`` (as :func:`igl_hhj.curvature.check_principal_curvature_args`)."""
+
+
 def check_curvature_options(method, per, radius=None):
     """Raise ``ValueError`` for a combination ``igl-hhj curvature`` / ``batch`` cannot compute.
 
@@ -130,6 +138,8 @@ def check_curvature_options(method, per, radius=None):
         if radius < 0 or (radius == 0 and not (method == "hhj" and per == "face")):
             raise ValueError(f"--radius must be a positive integer (0 only with --per face), "
                              f"got {radius}")
+        if radius > MAX_RADIUS:
+            raise ValueError(f"--radius must be at most {MAX_RADIUS} (10**6), got {radius:.3g}")
 
 
 def default_radius(method, per):
@@ -282,6 +292,57 @@ class Options:
     def sandboxed(self):
         """Run each mesh in a sandbox child process (needed to enforce the limits)."""
         return self.timeout is not None or self.memory_limit is not None
+
+
+OPTIONS_FILE = ".igl-hhj-options.json"
+"""``OUTDIR/OPTIONS_FILE``: ``{output relative to OUTDIR: {"options": {method, per, radius},
+"done": bool, "t": ns}}``.  ``done`` False: the output was being recomputed with ``options``
+from time ``t`` on (an output newer than ``t`` has them, e.g. one finished by a worker
+after an interrupt; an older one still has its previous, unknown options)."""
+
+
+def options_key(method, per, radius):
+    """The options an output depends on (radius None → :func:`default_radius`)."""
+    return {"method": method, "per": per,
+            "radius": default_radius(method, per) if radius is None else int(radius)}
+
+
+def describe_options(key):
+    if key is None:
+        return "unknown options"
+    text = f"--method {key['method']} --per {key['per']}"
+    return text + (f" --radius {key['radius']}" if key.get("radius") is not None else "")
+
+
+def _read_options_file(outdir):
+    import json
+    try:
+        with open(Path(outdir) / OPTIONS_FILE) as fh:
+            data = json.load(fh)
+        return data if isinstance(data, dict) else {}
+    except (OSError, ValueError):
+        return {}
+
+
+def _write_options_file(outdir, entries):
+    import json
+    path = Path(outdir) / OPTIONS_FILE
+    tmp = Path(outdir) / f".igl-hhj-options.{os.getpid()}.json.new"
+    with open(tmp, "w") as fh:
+        json.dump(entries, fh, indent=0, sort_keys=True)
+    os.replace(tmp, path)
+
+
+def _made_with(entry, output):
+    """The options ``output`` was computed with according to its entry, or None."""
+    if not isinstance(entry, dict) or not isinstance(entry.get("options"), dict):
+        return None
+    if entry.get("done"):
+        return entry["options"]
+    try:
+        return entry["options"] if os.stat(output).st_mtime_ns > int(entry.get("t", 0)) else None
+    except (OSError, TypeError, ValueError):
+        return None
 
 
 def _row(job, status, **kw):
@@ -497,9 +558,9 @@ def plan_jobs(inputs, outdir, fmt="npz"):
     that differ only in extension keep it: ``a/b.off.npz``)."""
     if fmt not in FORMATS:
         raise ValueError(f"unknown format {fmt!r} (use {', '.join(FORMATS)})")
-    out_abs = os.path.abspath(outdir) + os.sep
+    out_abs = os.path.realpath(outdir) + os.sep            # realpath: also through symlinks
     found = [(q, r) for q, r in collect_inputs(inputs)       # outputs are never inputs
-             if not os.path.abspath(q).startswith(out_abs)]
+             if not os.path.realpath(q).startswith(out_abs)]
     if not found:
         return []
     roots = [os.path.abspath(r) for _, r in found]
@@ -676,6 +737,9 @@ class BatchResult:
     mode: str = ""
     interrupted: bool = False
     total: int = 0
+    recomputed: dict = field(default_factory=dict)
+    """{description of the options an up-to-date output had: count} of the outputs
+    recomputed because they were computed with other (or unknown) options."""
 
     def counts(self):
         c = {s: 0 for s in ("ok", "error", "skipped", "timeout")}
@@ -840,6 +904,8 @@ def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per
         raise ValueError(f"memory limit must be positive, got {memory_limit}")
     if workers is not None and workers < 0:
         raise ValueError(f"workers must be ≥ 0, got {workers}")
+    if workers is not None and workers > MAX_WORKERS:
+        raise ValueError(f"workers must be at most {MAX_WORKERS} (one process each), got {workers}")
     t0 = time.perf_counter()
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
@@ -848,13 +914,26 @@ def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per
         raise ValueError("no input meshes")
     options = Options(method, per, None if radius is None else int(radius), fmt, timeout, memory_limit)
     previous = _previous_rows(outdir / "summary.csv")
+    key = options_key(method, per, radius)
+    made = _read_options_file(outdir)
+    rel = {job.path: os.path.relpath(job.output, outdir) for job in jobs}
     rows = {}
     todo = []
+    recomputed = {}
     for job in jobs:
         if resume and _up_to_date(job):
-            rows[job.path] = _skipped_row(job, previous)
-        else:
-            todo.append(job)
+            was = _made_with(made.get(rel[job.path]), job.output)
+            if was == key:
+                rows[job.path] = _skipped_row(job, previous)
+                continue
+            what = describe_options(was)
+            recomputed[what] = recomputed.get(what, 0) + 1
+        todo.append(job)
+    now = time.time_ns()
+    for job in todo:
+        made[rel[job.path]] = {"options": key, "done": False, "t": now}
+    if todo:
+        _write_options_file(outdir, made)
     bar = _Progress(len(jobs), progress, stream)
     for job in jobs:
         if job.path in rows:
@@ -862,6 +941,8 @@ def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per
 
     def on_row(row):
         rows[row["path"]] = row
+        if row["status"] == "ok" and row["path"] in rel:
+            made[rel[row["path"]]]["done"] = True
         bar.update(row)
 
     in_process = client is None and scheduler is None and (
@@ -912,6 +993,9 @@ def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per
         if box is not None:
             box.close()
         sweep_temporaries(outdir)
+        if todo:
+            _write_options_file(outdir, made)
         done = [rows[j.path] for j in jobs if j.path in rows]
         files = write_summary(done, outdir)
-    return BatchResult(done, outdir, files, time.perf_counter() - t0, mode, interrupted, len(jobs))
+    return BatchResult(done, outdir, files, time.perf_counter() - t0, mode, interrupted, len(jobs),
+                       recomputed)

@@ -40,7 +40,10 @@ def _interrupted_at_startup(signum, frame):      # Ctrl-C while the imports belo
     os._exit(130)
 
 
-if __name__ == "__main__" or os.path.basename(sys.argv[0] if sys.argv else "") in ("igl-hhj", "cli.py"):
+# not in batch workers: multiprocessing re-runs this module there as __mp_main__ (with the
+# parent's argv) and they inherit SIGINT ignored; each used to print "interrupted" too
+if (__name__ == "__main__" or os.path.basename(sys.argv[0] if sys.argv else "") in ("igl-hhj", "cli.py")) \
+        and __name__ != "__mp_main__" and signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:
     try:
         signal.signal(signal.SIGINT, _interrupted_at_startup)
     except (ValueError, OSError):                # not the main thread
@@ -243,6 +246,11 @@ def _curvature(args):
     if not 0 <= args.robust < 50:
         raise UserError(f"--robust must be a percentile in [0, 50), got {args.robust}")
     if args.out is not None:
+        if not str(args.out).strip():
+            raise UserError("-o/--out: empty output path")
+        if os.path.realpath(args.out) == os.path.realpath(args.mesh):
+            raise UserError(f"-o {args.out}: is the input mesh itself; refusing to overwrite it "
+                            f"(choose another output file)")
         _check_writable(args.out)
     if args.screenshot is not None:
         _check_writable(args.screenshot, (".png",))
@@ -363,6 +371,11 @@ def _batch(args):
     from . import batch
     if args.workers is not None and args.workers < 0:
         raise UserError(f"--workers must be at least 0, got {args.workers}")
+    if args.workers is not None and args.workers > batch.MAX_WORKERS:
+        raise UserError(f"--workers must be at most {batch.MAX_WORKERS} (one process each), "
+                        f"got {args.workers}")
+    if not str(args.out).strip():
+        raise UserError("-o/--out: empty output path")
     try:
         result = batch.run_batch(args.inputs, args.out, scheduler=args.scheduler,
                                  workers=args.workers, method=args.method, per=args.per,
@@ -375,6 +388,10 @@ def _batch(args):
         raise UserError(str(exc)) from None
     except OSError as exc:
         raise UserError(f"{args.out}: {exc.strerror or exc}") from None
+    for was, n in result.recomputed.items():
+        print(f"igl-hhj: recomputed {n} mesh{'es' if n > 1 else ''} whose output had {was} "
+              f"(now {batch.describe_options(batch.options_key(args.method, args.per, args.radius))})",
+              file=sys.stderr)
     c = result.counts()
     of = f" of {result.total}" if len(result.rows) < result.total else ""
     print(f"{len(result.rows)}{of} meshes: {c['ok']} ok, {c['error']} error, {c['timeout']} timeout, "

@@ -162,7 +162,10 @@ def _normalised_boundary_normals(mesh, boundary_normals, clamped):
 def _simply_supported_values(mesh, boundary_shape_operator, ss_edges):
     """ρ_e^k = -ν_T^k · mean_e(nᵀ S~ n), eq. (5.18) with P1-interpolated S~. Returns (#E, 3)."""
     S = per_vertex_array(mesh, boundary_shape_operator, "boundary_shape_operator", (3, 3))
-    _data_rows(mesh, S, ss_edges, "boundary_shape_operator")
+    v = _data_rows(mesh, S, ss_edges, "boundary_shape_operator")
+    asym = np.abs(S[v] - S[v].transpose(0, 2, 1)).max(axis=(1, 2)) > 1e-8 * (1 + np.abs(S[v]).max(axis=(1, 2)))
+    if asym.any():                  # a shape operator is symmetric; only nᵀ S n would be used
+        raise ValueError(f"boundary_shape_operator is not symmetric at boundary vertex {int(v[asym][0])}")
     rho = np.zeros((mesh.n_edges, 3))
     e = np.flatnonzero(ss_edges)
     f, n = _boundary_face_and_conormal(mesh, e)
@@ -416,7 +419,7 @@ def surface_hessian(V: Any, F: ArrayLike | None, w: ArrayLike, *, boundary_gradi
         W = per_vertex_array(mesh, w_arr, "w")[:, None]
     else:
         if w_arr.ndim != 2:
-            raise ValueError(f"w must have shape (#V,) or (#V, k), got {w_arr.shape}")
+            raise ValueError("w is required: the (#V,) or (#V, k) vertex values of the function(s) to differentiate" if w is None else f"w must have shape (#V,) or (#V, k), got {w_arr.shape}")
         W = per_vertex_array(mesh, w_arr, "w", (w_arr.shape[1],))
     ref = mesh.referenced_vertices
     if not np.isfinite(W[ref]).all():
@@ -541,8 +544,8 @@ def smoothed_face_shape_operator(mesh, S, smoothing):
 def _check_smoothing(x, name):
     if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, float, np.integer, np.floating)):
         raise TypeError(f"{name} must be a number, got {type(x).__name__}")
-    if not (np.isfinite(x) and x >= 0):
-        raise ValueError(f"{name} must be finite and >= 0, got {x}")
+    if not 0 <= x <= 10**6:                 # also NaN, inf and ints beyond float64
+        raise ValueError(f"{name} must be finite, >= 0 and <= 10**6, got {x:.3g}")
 
 
 def face_mean_curvature(V: Any, F: ArrayLike | None = None, **boundary: Any) -> NDArray[np.float64]:
@@ -565,6 +568,8 @@ def check_principal_curvature_args(radius, useKring):
         raise TypeError(f"radius must be an int (as in igl.principal_curvature), got {type(radius).__name__}")
     if not radius > 0:
         raise ValueError(f"radius must be positive, got {radius}")
+    if radius > 10**6:      # a smoothing scale / k-ring beyond any mesh; 10**300 overflowed
+        raise ValueError(f"radius must be <= 10**6 (a smoothing scale in rings), got {radius:.3g}")
     if not isinstance(useKring, (bool, np.bool_)):
         raise TypeError(f"useKring must be a bool (as in igl.principal_curvature), got {type(useKring).__name__}")
 

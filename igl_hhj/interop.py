@@ -2,7 +2,8 @@
 
 Everywhere igl_hhj takes ``(V, F)`` it also takes a mesh object in place of
 ``V`` with ``F`` omitted (or None): a ``trimesh.Trimesh``, a triangulated
-``pyvista.PolyData`` or a ``meshio.Mesh`` with triangle cells.  The objects
+``pyvista.PolyData``, a ``pyvista.UnstructuredGrid`` of triangles or a
+``meshio.Mesh`` with triangle cells.  The objects
 are recognised by their attributes (duck typing), so none of those libraries
 is a dependency; :func:`mesh_arrays` is the one adapter
 (:func:`igl_hhj.mesh.as_mesh` calls it).  The arrays are copied and validated
@@ -31,11 +32,17 @@ import numpy as np
 __all__ = ["mesh_arrays", "is_mesh_object", "to_trimesh", "to_pyvista", "to_meshio", "result_fields"]
 
 _SURFACE_CELLS = {"triangle", "quad", "polygon", "triangle6", "quad8", "quad9"}
+_VTK_TRIANGLE = 5
+_VTK_NAMES = {1: "vertex", 3: "line", 4: "polyline", 7: "polygon", 9: "quad", 10: "tetra",
+              12: "hexahedron", 13: "wedge", 14: "pyramid", 22: "quadratic triangle"}
 _VOLUME_CELLS = {"tetra", "hexahedron", "wedge", "pyramid", "tetra10", "hexahedron20", "hexahedron27"}
 
 
 def _kind(obj: Any) -> str | None:
-    """"meshio", "pyvista", "trimesh" or None, from the object's attributes."""
+    """"meshio", "pyvista", "pyvista_grid", "trimesh" or None, from the object's attributes."""
+    if hasattr(obj, "points") and hasattr(obj, "cells") and hasattr(obj, "celltypes") \
+            and hasattr(obj, "n_points"):                 # pyvista.UnstructuredGrid (has cells_dict too)
+        return "pyvista_grid"
     if hasattr(obj, "points") and hasattr(obj, "cells") and hasattr(obj, "cells_dict"):
         return "meshio"
     if hasattr(obj, "points") and hasattr(obj, "faces") and hasattr(obj, "n_points"):
@@ -55,7 +62,7 @@ def mesh_arrays(obj: Any) -> tuple[np.ndarray, np.ndarray] | None:
 
     Parameters
     ----------
-    obj : trimesh.Trimesh, pyvista.PolyData or meshio.Mesh (anything with the
+    obj : trimesh.Trimesh, pyvista.PolyData, pyvista.UnstructuredGrid or meshio.Mesh (anything with the
         same attributes)
 
     Returns
@@ -80,6 +87,20 @@ def mesh_arrays(obj: Any) -> tuple[np.ndarray, np.ndarray] | None:
         return None
     if kind == "trimesh":
         return np.asarray(obj.vertices), np.asarray(obj.faces)
+    if kind == "pyvista_grid":
+        vtk_types = np.asarray(obj.celltypes).ravel()
+        flat = np.asarray(obj.cells).ravel()
+        if vtk_types.size == 0:
+            raise ValueError("the pyvista UnstructuredGrid has no cells")
+        if not np.all(vtk_types == _VTK_TRIANGLE):
+            names = sorted({_VTK_NAMES.get(int(t), f"VTK type {int(t)}") for t in np.unique(vtk_types)
+                            if t != _VTK_TRIANGLE})
+            raise ValueError(f"the pyvista UnstructuredGrid has {', '.join(names)} cells: only triangles "
+                             f"are supported (grid.extract_surface().triangulate() first)")
+        if flat.size != 4 * vtk_types.size or not np.all(flat[0::4] == 3):
+            raise ValueError("the pyvista UnstructuredGrid's cell connectivity does not match its "
+                             "triangle cell types")
+        return np.asarray(obj.points), flat.reshape(-1, 4)[:, 1:]
     if kind == "pyvista":
         V = np.asarray(obj.points)
         flat = np.asarray(obj.faces).ravel()
@@ -182,4 +203,7 @@ def to_meshio(V: Any, F: Any = None, results: Any = None) -> Any:
     import meshio
     V, F, results = _validated(V, F, results)
     pv_, pf = result_fields(results, len(V), len(F))
-    return meshio.Mesh(V, [("triangle", F)], point_data=pv_, cell_data={k: [v] for k, v in pf.items()})
+    # tensors as (n, 9) rows: meshio writes a (n, 3, 3) array into .vtu with a wrong layout
+    flat = {k: (v.reshape(len(v), -1) if v.ndim > 2 else v) for k, v in pv_.items()}
+    return meshio.Mesh(V, [("triangle", F)], point_data=flat,
+                       cell_data={k: [v.reshape(len(v), -1) if v.ndim > 2 else v] for k, v in pf.items()})

@@ -109,6 +109,8 @@ def _zero_area(dbl, l2max):
 
 
 def _as_array(x, name):
+    if np.ma.is_masked(x):          # np.asarray would silently use the values under the mask
+        raise ValueError(f"{name} is a masked array with {np.ma.count_masked(x)} masked entries: fill or drop them first")
     if isinstance(x, np.ndarray):
         return x
     try:
@@ -133,7 +135,7 @@ def validate_vertices(V, name="V"):
         raise ValueError(f"{name} is empty: the mesh has no vertices")
     if V.dtype == object or not (np.issubdtype(V.dtype, np.floating)
                                  or np.issubdtype(V.dtype, np.integer)):
-        raise TypeError(f"{name} must hold real numbers, got dtype {V.dtype}")
+        raise TypeError(f"{name} must hold real numbers, got dtype {V.dtype}" + (f": {name} is a {type(V.item()).__name__}; pass the mesh object alone (f(mesh), without F)" if V.ndim == 0 and (hasattr(V.item(), "faces") or hasattr(V.item(), "n_faces")) else ""))
     if V.ndim != 2 or V.shape[1] != 3:
         raise ValueError(f"{name} must have shape (#V, 3), got shape {V.shape}")
     if V.shape[0] == 0:

@@ -274,11 +274,64 @@ def _check_off_body(path, nV, nF):
                 "vertex line is not three (or more) numbers")
     f = slice(h + nV, h + nV + nF)
     k = L.first[f]
+    wrapped = np.flatnonzero((k >= 3) & (L.ntok[f] < 1 + k))
+    if wrapped.size:                               # a face record continues on the next lines
+        w = h + nV + int(wrapped[0])
+        f = slice(h + nV, w)
+        k = L.first[f]
     _check_rows(path, L, f, k < 0, "face line does not start with its corner count")
     _check_rows(path, L, f, k < 3, "face with fewer than 3 corners")
-    _check_rows(path, L, f, L.ntok[f] < 1 + k,
-                "face line claims more corners than it lists (truncated or corrupt)")
     _check_rows(path, L, f, L.int_k[f] != k, "face corner is not a non-negative integer index")
+    if wrapped.size:
+        _check_off_wrapped_faces(path, L, w, nF - int(wrapped[0]))
+
+
+def _line_tokens(fh, L, i):
+    """Tokens of the i-th non-empty line (comments removed), read from the open file."""
+    fh.seek(int(L.offset[i]))
+    return fh.readline().split(b"#")[0].split()
+
+
+def _check_off_wrapped_faces(path, L, start, n):
+    """OFF face records from line ``start`` on, token by token as libigl reads them: the
+    corner count, then that many indices over as many lines as they take (the rest of the
+    line of the last index is ignored).  Only reached when some record wraps a line."""
+    with open(path, "rb") as fh:
+        _wrapped_faces(path, fh, L, start, n)
+
+
+def _wrapped_faces(path, fh, L, start, n):
+    i = start
+    for _ in range(n):
+        if i >= len(L):
+            raise MeshFileError(f"{path}: truncated: the file ends before its last face records")
+        line = i
+        if L.first[i] < 0:
+            _first_bad(path, L, np.arange(len(L)) == i, "face line does not start with its corner count")
+        k = int(L.first[i])
+        if k < 3:
+            _first_bad(path, L, np.arange(len(L)) == i, "face with fewer than 3 corners")
+        need = k
+        toks = _line_tokens(fh, L, i)[1:]
+        while True:
+            take = toks[:need]
+            if not all(t.isdigit() for t in take):
+                _first_bad(path, L, np.arange(len(L)) == i,
+                           "face corner is not a non-negative integer index")
+            need -= len(take)
+            if need == 0:
+                break
+            i += 1
+            if i >= len(L):
+                _first_bad(path, L, np.arange(len(L)) == line,
+                           "face line claims more corners than it lists (truncated or corrupt)")
+            toks = _line_tokens(fh, L, i)
+        if i > line:                               # libigl's reader crashes on a '#' in a record
+            fh.seek(int(L.offset[line]))
+            if b"#" in fh.read(int(L.offset[i] - L.offset[line])):
+                _first_bad(path, L, np.arange(len(L)) == line,
+                           "comment inside a face record that continues on the next line")
+        i += 1
 
 
 def _check_rows(path, L, rows, bad, what):
@@ -636,6 +689,35 @@ def read_mesh(path):
         which libigl read no faces.
     """
     path, ext, head = _check_input_file(path)
+    if head.startswith(_BOM) and ext in (".obj", ".off", ".ply"):
+        return _read_without_bom(path)
+    return _read_checked(path, ext, head)
+
+
+_BOM = b"\xef\xbb\xbf"
+
+
+def _read_without_bom(path):
+    """A UTF-8 byte-order mark in front of an OBJ / OFF / PLY: libigl would lose the first
+    line (OBJ: the first vertex, then a misleading index error) or reject the file, so read
+    a copy without the three bytes; messages name the original file."""
+    import shutil
+    tmpdir = tempfile.mkdtemp(prefix="igl_hhj_bom_")
+    copy = Path(tmpdir) / path.name
+    try:
+        with open(path, "rb") as src, open(copy, "wb") as dst:
+            src.seek(len(_BOM))
+            shutil.copyfileobj(src, dst, 1 << 20)
+        _, ext, head = _check_input_file(copy)
+        try:
+            return _read_checked(copy, ext, head)
+        except MeshFileError as exc:
+            raise MeshFileError(str(exc).replace(str(copy), str(path))) from None
+    finally:
+        shutil.rmtree(tmpdir, ignore_errors=True)
+
+
+def _read_checked(path, ext, head):
     size = path.stat().st_size
     if ext == ".off":
         _check_off_header(path, head, size)

@@ -1,4 +1,6 @@
 """Baseline estimators (igl_hhj.baselines) and Heine's surfaces (igl_hhj.surfaces.heine)."""
+import warnings
+
 import numpy as np
 import pytest
 
@@ -255,3 +257,31 @@ def test_hhj_estimates_from_a_precomputed_shape_operator():
             fn(V, F, shape_operator=S[:-1])
         with pytest.raises(TypeError, match="cannot be combined"):
             fn(V, F, shape_operator=S, solver="cg")
+
+
+def test_nan_rows_are_listed_in_bad():
+    """libigl_cotan on a flat two-sided disc: the rim's vertex normals cancel, H is NaN there,
+    and those rows used to be missing from ``bad``."""
+    n = 8
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    V = np.vstack([np.column_stack([np.cos(t), np.sin(t), 0 * t]), [[0, 0, 0], [0, 0, 0.0]]])
+    F = np.array([[i, (i + 1) % n, n] for i in range(n)] + [[(i + 1) % n, i, n + 1] for i in range(n)])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        est = B.estimate("libigl_cotan", V, F)
+    nan = np.flatnonzero(np.isnan(est.k1) | np.isnan(est.H) | np.isnan(est.K))
+    assert nan.size and set(nan) <= set(est.bad)
+
+
+@pytest.mark.parametrize("scale", [1e-50, 1e70])
+def test_pymeshlab_far_scales_are_rescaled(scale):
+    """MeshLab aborted the process (double free) for coordinates scaled 1e-50 / 1e70; the
+    mesh is now handed over at unit size and the curvatures scaled back."""
+    pytest.importorskip("pymeshlab")
+    V, F = icosphere(2)
+    ref = B.estimate("pymeshlab_quadric", V, F)
+    est = B.estimate("pymeshlab_quadric", V * scale, F)
+    np.testing.assert_allclose(est.k1 * scale, ref.k1, rtol=1e-5)
+    np.testing.assert_allclose(est.H * scale, ref.H, rtol=1e-5)
+    np.testing.assert_allclose(est.K * scale ** 2, ref.K, rtol=1e-5)
+    np.testing.assert_allclose(np.abs(np.einsum("ij,ij->i", est.d1, ref.d1)), 1, atol=1e-4)

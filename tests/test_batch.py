@@ -295,6 +295,7 @@ def test_resume_after_sigint(tmp_path):
             proc.wait()
     assert proc.returncode == 130, stderr
     assert "interrupted" in stderr and "Traceback" not in stderr   # workers ignore SIGINT
+    assert stderr.count("interrupted") == 1, stderr        # (each worker used to print it too)
     assert not list(out.rglob("*.igl-hhj-tmp*"))          # no partial outputs
     finished = sorted(out.rglob("m*.npz"))
     for f in finished:                                      # every output present is complete
@@ -452,3 +453,83 @@ def test_progress_bar_on_a_terminal(collection, tmp_path):
     text = out.decode(errors="replace")
     assert "2/2" in text and "mesh/s" in text and "failed=1" in text
     assert "[1/2]" not in text                      # no plain lines on a terminal
+
+
+def test_output_folder_through_a_symlink_is_not_read_as_input(tmp_path, capsys):
+    """OUT is a symlink to IN/out: the outputs of the first run used to be inputs of the second."""
+    folder = tmp_path / "in"
+    folder.mkdir()
+    V, F = igl.icosahedron()
+    for i in range(2):
+        igl.write_triangle_mesh(str(folder / f"m{i}.off"), V, F)
+    (folder / "out").mkdir()
+    link = tmp_path / "link"
+    link.symlink_to(folder / "out")
+    for _ in range(2):
+        assert cli.main(["batch", str(folder), "-o", str(link), "--format", "ply",
+                         "--workers", "0", "-q"]) == 0
+        rows = read_summary(link)
+        assert sorted(Path(p).name for p in rows) == ["m0.off", "m1.off"]
+    assert [j.path for j in batch.plan_jobs([folder], link, "ply")] == \
+        [str(folder / "m0.off"), str(folder / "m1.off")]
+
+
+def test_too_many_workers_and_empty_out_are_usage_errors(tmp_path, capsys):
+    V, F = igl.icosahedron()
+    igl.write_triangle_mesh(str(tmp_path / "m.off"), V, F)
+    assert cli.main(["batch", str(tmp_path / "m.off"), "-o", str(tmp_path / "x"),
+                     "--workers", "100000"]) == 2
+    assert "--workers must be at most 256" in capsys.readouterr().err
+    with pytest.raises(ValueError, match="at most 256"):
+        batch.run_batch([tmp_path / "m.off"], tmp_path / "x", workers=100000)
+    assert cli.main(["batch", str(tmp_path / "m.off"), "-o", ""]) == 2
+    assert "empty output path" in capsys.readouterr().err
+
+
+def test_resume_recomputes_when_the_options_change(tmp_path, capsys):
+    """``batch in -o out`` then ``--method igl`` used to skip every mesh and keep HHJ's values."""
+    folder = tmp_path / "in"
+    folder.mkdir()
+    V, F = igl.icosahedron()
+    V, F = igl.upsample(V, F)
+    V = V / np.linalg.norm(V, axis=1, keepdims=True)
+    for i in range(2):
+        igl.write_triangle_mesh(str(folder / f"m{i}.off"), V * (i + 1), F)
+    out = tmp_path / "out"
+
+    def run(*extra):
+        assert cli.main(["batch", str(folder), "-o", str(out), "--workers", "0", "-q", *extra]) == 0
+        err = capsys.readouterr().err
+        return {r["status"] for r in read_summary(out).values()}, err
+
+    assert run()[0] == {"ok"}
+    assert run()[0] == {"skipped"}
+    with np.load(out / "m0.npz") as z:
+        hhj = z["k1"].copy()
+    status, err = run("--method", "igl")
+    assert status == {"ok"}
+    assert "recomputed 2 meshes whose output had --method hhj --per vertex --radius 5" in err
+    assert "(now --method igl --per vertex --radius 5)" in err
+    with np.load(out / "m0.npz") as z:
+        assert not np.allclose(z["k1"], hhj)
+    assert run("--method", "igl") == ({"skipped"}, "")
+    assert run("--method", "igl", "--radius", "3")[0] == {"ok"}
+    assert run("--per", "face")[0] == {"ok"}
+    assert run("--per", "face")[0] == {"skipped"}
+    assert run("--per", "face", "--radius", "0")[0] == {"skipped"}     # 0 is the default per face
+    assert run()[0] == {"ok"}
+    (out / batch.OPTIONS_FILE).unlink()                     # unknown options: recomputed
+    status, err = run()
+    assert status == {"ok"} and "had unknown options" in err
+
+
+def test_pending_options_entry_dates_the_output(tmp_path):
+    """An output being recomputed when the run stopped: newer than the entry → the new options."""
+    out = tmp_path / "o.npz"
+    out.write_bytes(b"x")
+    key = batch.options_key("igl", "vertex", None)
+    mtime = os.stat(out).st_mtime_ns
+    assert batch._made_with({"options": key, "done": False, "t": mtime - 1}, str(out)) == key
+    assert batch._made_with({"options": key, "done": False, "t": mtime + 1}, str(out)) is None
+    assert batch._made_with({"options": key, "done": True, "t": mtime + 1}, str(out)) == key
+    assert batch._made_with(None, str(out)) is None and batch._made_with("junk", str(out)) is None

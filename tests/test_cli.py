@@ -579,3 +579,31 @@ def test_demos_leave_no_files_and_no_egl_chatter(tmp_path, argv):
     assert res.returncode == 0, res.stderr[-2000:]
     assert sorted(p.name for p in tmp_path.iterdir()) == [("r.png" if "regge" in argv else "igl_hhj_demo.png")]
     assert "[polyscope]" not in res.stdout + res.stderr, res.stdout + res.stderr
+
+
+def test_output_that_is_the_input_is_refused(sphere, tmp_path, capsys):
+    """``curvature in.ply -o in.ply`` used to overwrite the mesh with its curvature."""
+    _, V, F = sphere
+    mesh_path = tmp_path / "in.ply"
+    igl.write_triangle_mesh(str(mesh_path), V, F)
+    before = mesh_path.read_bytes()
+    link = tmp_path / "link.ply"
+    link.symlink_to(mesh_path)
+    for out in (mesh_path, link, tmp_path / "." / "in.ply"):
+        assert cli.main(["curvature", str(mesh_path), "-o", str(out)]) == 2
+        assert "is the input mesh itself" in one_error_line(capsys.readouterr().err)
+    assert mesh_path.read_bytes() == before
+
+
+def test_empty_output_path_is_a_usage_error(sphere, capsys):
+    path, _, _ = sphere
+    assert cli.main(["curvature", str(path), "-o", ""]) == 2
+    assert "empty output path" in one_error_line(capsys.readouterr().err)
+
+
+@pytest.mark.parametrize("extra", [[], ["--method", "igl"], ["--per", "face"]])
+def test_huge_radius_is_a_usage_error(sphere, capsys, extra):
+    """--radius 10**300 used to exit 70 (internal error: OverflowError)."""
+    path, _, _ = sphere
+    assert cli.main(["curvature", str(path), "--radius", str(10**300)] + extra) == 2
+    assert "--radius must be at most 1000000" in one_error_line(capsys.readouterr().err)

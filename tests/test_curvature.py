@@ -272,3 +272,44 @@ def test_interior_data_rows_may_be_nan():
     N[~m.boundary_vertices] = np.nan
     S = igl_hhj.shape_operator(V, F, boundary_normals=N)
     assert np.isfinite(S).all()
+
+
+def test_huge_radius_is_one_value_error():
+    """radius=10**300 used to raise OverflowError (smoothing: TypeError from np.isfinite)."""
+    from igl_hhj.surfaces import icosphere
+    V, F = icosphere(1)
+    for big in (10**300, 10**6 + 1):
+        with pytest.raises(ValueError, match=r"radius must be <= 10\*\*6"):
+            igl_hhj.principal_curvature(V, F, radius=big)
+        with pytest.raises(ValueError, match=r"smoothing must be .*<= 10\*\*6"):
+            igl_hhj.face_principal_curvature(V, F, smoothing=big)
+    with pytest.raises(ValueError, match="smoothing must be"):
+        igl_hhj.face_principal_curvature(V, F, smoothing=float("nan"))
+
+
+def test_non_symmetric_boundary_shape_operator_names_the_vertex():
+    s, (V, F) = _open_patch()
+    Sx = s.shape_operator(V).copy()
+    Sx[0, 0, 1] += 0.5                      # vertex 0 is on the boundary (corner of the square)
+    with pytest.raises(ValueError, match="not symmetric at boundary vertex 0"):
+        igl_hhj.shape_operator(V, F, boundary_shape_operator=Sx)
+    igl_hhj.shape_operator(V, F, boundary_shape_operator=s.shape_operator(V))   # symmetric: fine
+
+
+def test_message_hints():
+    from igl_hhj.mesh import TriangleMesh
+    from igl_hhj.surfaces import icosphere
+    V, F = icosphere(1)
+    with pytest.raises(TypeError, match="V is a TriangleMesh; pass the mesh object alone"):
+        igl_hhj.principal_curvature(TriangleMesh(V, F), F)
+    with pytest.raises(ValueError, match="w is required"):
+        igl_hhj.surface_hessian(V, F, None)
+    Vm = np.ma.masked_array(V, mask=np.zeros(V.shape, bool))
+    Vm[3, 1] = np.ma.masked
+    with pytest.raises(ValueError, match="V is a masked array with 1 masked entries"):
+        igl_hhj.principal_curvature(Vm, F)
+    Fm = np.ma.masked_array(F)
+    Fm[0, 0] = np.ma.masked
+    with pytest.raises(ValueError, match="F is a masked array"):
+        igl_hhj.face_mean_curvature(V, Fm)
+    igl_hhj.face_mean_curvature(np.ma.masked_array(V), F)          # nothing masked: accepted

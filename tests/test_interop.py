@@ -123,3 +123,49 @@ def test_viewer_takes_objects(mesh):
     reg = viewer.register_comparison(trimesh.Trimesh(V, F, process=False), name="tm")
     assert set(reg.structures) == {"tm HHJ", "tm libigl"}
     ps.remove_all_structures()
+
+
+def test_tensors_round_trip_through_vtu(mesh, tmp_path):
+    """(#F, 3, 3) tensors used to be written into .vtu with a corrupt layout: now (#F, 9)."""
+    meshio = pytest.importorskip("meshio")
+    V, F = mesh
+    S = igl_hhj.shape_operator(V, F)
+    Sv = np.random.default_rng(0).normal(size=(len(V), 3, 3))
+    m = interop.to_meshio(V, F, {"S": S, "Sv": Sv})
+    assert m.cell_data["S"][0].shape == (len(F), 9) and m.point_data["Sv"].shape == (len(V), 9)
+    m.write(tmp_path / "s.vtu")
+    back = meshio.read(tmp_path / "s.vtu")
+    np.testing.assert_allclose(back.cell_data["S"][0].reshape(-1, 3, 3), S)
+    np.testing.assert_allclose(back.point_data["Sv"].reshape(-1, 3, 3), Sv)
+
+
+class _FakeGrid:
+    """The attributes of a pyvista.UnstructuredGrid that the adapter reads."""
+
+    def __init__(self, V, F, types=None):
+        self.points = V
+        self.n_points = len(V)
+        self.cells = np.column_stack([np.full(len(F), 3), F]).ravel()
+        self.celltypes = np.full(len(F), 5, np.uint8) if types is None else types
+        self.cells_dict = {5: F}
+
+
+def test_unstructured_grid_of_triangles_is_a_mesh_object(mesh):
+    V, F = mesh
+    grid = _FakeGrid(V, F)
+    assert interop.is_mesh_object(grid)
+    V2, F2 = interop.mesh_arrays(grid)
+    np.testing.assert_array_equal(V2, V)
+    np.testing.assert_array_equal(F2, F)
+    np.testing.assert_allclose(igl_hhj.face_mean_curvature(grid), igl_hhj.face_mean_curvature(V, F))
+    with pytest.raises(ValueError, match="tetra cells: only triangles"):
+        interop.mesh_arrays(_FakeGrid(V, F, np.r_[np.full(len(F) - 1, 5), 10].astype(np.uint8)))
+
+
+def test_real_pyvista_unstructured_grid(mesh):
+    pv = pytest.importorskip("pyvista")
+    V, F = mesh
+    grid = pv.PolyData(V, np.column_stack([np.full(len(F), 3), F]).ravel()).cast_to_unstructured_grid()
+    V2, F2 = interop.mesh_arrays(grid)
+    np.testing.assert_allclose(V2, V)
+    np.testing.assert_array_equal(F2, F)

@@ -238,6 +238,59 @@ def test_long_ply_header_reads():
     assert len(FILES["long_header.ply"][0]) > 1 << 16
 
 
+_TRI = b"0 0 0\n1 0 0\n0 1 0\n"
+
+
+@pytest.mark.parametrize("body", [b"3 0\n1 2\n", b"3\n0\n1\n2\n", b"3 0\n\n1 2 255 0 0 # c\n"])
+def test_off_face_records_may_wrap_lines(tmp_path, body):
+    """libigl reads OFF faces token by token; the guard does too (it used to reject these)."""
+    from igl_hhj.mesh_io import read_mesh
+    path = tmp_path / "w.off"
+    path.write_bytes(b"OFF\n3 2 0\n" + _TRI + body + b"3 0 1 2\n")
+    V, F, _ = read_mesh(path)
+    assert V.shape == (3, 3) and F.tolist() == [[0, 1, 2], [0, 1, 2]]
+
+
+@pytest.mark.parametrize("body, message", [
+    (b"3 0\n1\n", "claims more corners than it lists"),
+    (b"3 0\n1 x\n", "not a non-negative integer"),
+    (b"3 0 # c\n1 2\n", "comment inside a face record"),
+    (b"3 0\n# c\n1 2\n", "comment inside a face record"),
+    (b"2000000000 0\n1 2\n" + b"4 5 6\n" * 50, "claims more corners than it lists"),
+])
+def test_off_wrapped_face_records_are_still_checked(tmp_path, body, message):
+    from igl_hhj.mesh_io import MeshFileError, read_mesh
+    path = tmp_path / "w.off"
+    path.write_bytes(b"OFF\n3 1 0\n" + _TRI + body)
+    with pytest.raises(MeshFileError, match=message):
+        read_mesh(path)
+
+
+_PLY_TRI = _ply(b"0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")
+
+
+@pytest.mark.parametrize("name, content", [("b.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
+                                           ("b.off", b"OFF\n3 1 0\n" + _TRI + b"3 0 1 2\n"),
+                                           ("b.ply", _PLY_TRI)])
+def test_utf8_bom_is_skipped(tmp_path, name, content):
+    """A UTF-8 BOM used to cost an OBJ its first vertex (then a misleading index error)."""
+    from igl_hhj.mesh_io import read_mesh
+    path = tmp_path / name
+    path.write_bytes(b"\xef\xbb\xbf" + content)
+    V, F, _ = read_mesh(path)
+    np.testing.assert_array_equal(V, [[0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    assert F.tolist() == [[0, 1, 2]]
+
+
+def test_utf8_bom_errors_name_the_original_file(tmp_path):
+    from igl_hhj.mesh_io import MeshFileError, read_mesh
+    path = tmp_path / "t.off"
+    path.write_bytes(b"\xef\xbb\xbfOFF\n3 1 0\n0 0 0\n1 0 0\n")
+    with pytest.raises(MeshFileError) as info:
+        read_mesh(path)
+    assert str(info.value).startswith(str(path)) and "igl_hhj_bom_" not in str(info.value)
+
+
 # --------------------------------------------------------------------------- 3. regge index
 @pytest.mark.skipif(not LINUX, reason="RLIMIT_AS is Linux")
 def test_gauss_curvature_intrinsic_huge_index_in_capped_process():
