@@ -252,6 +252,23 @@ def test_shape_operator_repair_rows_in_callers_order():
     np.testing.assert_allclose(S[keep], S0, atol=1e-8)         # face 9 with the majority's sign
 
 
+def test_surface_hessian_repair():
+    w = np.c_[V2[:, 2] ** 2, V2[:, 0] * V2[:, 1]]
+    H0 = igl_hhj.surface_hessian(V2, F2, w)
+    F = np.vstack([F2[:20], F2[20:21, ::-1], F2[20:], [[4, 4, 5]]])   # reversed duplicate, repeated corner
+    with pytest.raises(ValueError, match="repeated vertex"):
+        igl_hhj.surface_hessian(V2, F, w)                      # strict by default
+    H, ws = call(igl_hhj.surface_hessian, V2, F, w, repair=True)
+    one_warning(ws, "surface Hessian", "duplicate", "repeated corner")
+    assert H.shape == (len(F), 2, 3, 3) and H.dtype == np.float64
+    assert np.isnan(H[[21, len(F) - 1]]).all()
+    np.testing.assert_allclose(H[np.r_[0:21, 22:len(F) - 1]], H0, atol=1e-8)
+    h1, _ = call(igl_hhj.surface_hessian, V2, F, w[:, 0], repair=True)
+    assert h1.shape == (len(F), 3, 3)
+    with pytest.raises(ValueError, match="one row per vertex"):
+        igl_hhj.surface_hessian(V2, F, w[:-1], repair=True)
+
+
 def test_boundary_data_is_mapped_to_the_repaired_vertices():
     keep = V2[F2].mean(axis=1)[:, 2] > 0.05                    # a cap: open mesh
     F = F2[keep]
