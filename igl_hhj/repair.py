@@ -38,7 +38,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .mesh import MeshDefectError, MeshWarning, validate_faces, validate_vertices, zero_area_faces
+from .mesh import MeshWarning, validate_faces, validate_vertices, zero_area_faces
 
 __all__ = ["RepairedMesh", "repair_mesh", "vertex_values_to_caller", "face_values_to_caller",
            "REPAIR_KINDS"]
