@@ -18,7 +18,8 @@ biharmonic solver, also as :func:`biharmonic_solve`), :mod:`igl_hhj.baselines`
 :mod:`igl_hhj.demos` (the demos, ``igl-hhj demo NAME``),
 :mod:`igl_hhj.surfaces` (exact test surfaces and mesh sequences), :mod:`igl_hhj.benchmarks`,
 :mod:`igl_hhj.cli` (the ``igl-hhj`` command), :mod:`igl_hhj.recovery` (vertex recovery and
-smoothing scale of the drop-in), :mod:`igl_hhj.boundary_estimation` (data-free boundary normals).
+smoothing scale of the drop-in), :mod:`igl_hhj.boundary_estimation` (data-free boundary normals),
+:mod:`igl_hhj.repair` (the drop-in's repair of meshes the strict functions refuse).
 """
 import importlib
 import pkgutil
@@ -33,7 +34,7 @@ __version__ = "0.1.0"
 _LAZY_MODULES = {"regge", "biharmonic", "baselines", "viewer", "surfaces", "benchmarks",
                  "hhj", "mesh", "convergence", "cli", "mesh_io", "mesh_report",
                  "curvature", "errors", "interop", "demos",
-                 "recovery", "boundary_estimation"}
+                 "recovery", "boundary_estimation", "repair"}
 # The core names resolve on first use too, so that ``import igl_hhj`` (and the
 # ``igl-hhj`` command's start-up, where Ctrl-C must not print a traceback) costs
 # no numpy/scipy import.

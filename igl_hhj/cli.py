@@ -11,7 +11,8 @@ Commands
     file, written to ``.npz``, ``.csv`` or ``.ply``; optional polyscope view
     or screenshot.
 ``igl-hhj info MESH``
-    what the mesh is made of and whether igl_hhj accepts it.
+    what the mesh is made of, whether igl_hhj accepts it, and which repairs the
+    drop-in ``principal_curvature`` would make to a refused one.
 ``igl-hhj batch INPUT... -o OUTDIR``
     ``curvature -o`` for many meshes on an embedded or existing Dask cluster
     (:mod:`igl_hhj.batch`); exit 1 when some meshes failed (rows in
@@ -569,7 +570,8 @@ def build_parser():
     i = sub.add_parser("info", help="mesh statistics and whether igl_hhj accepts the mesh",
                        description="Vertices, faces, edges, components, boundary loops, Euler "
                                    "characteristic, genus, manifoldness, orientation, degenerate and "
-                                   "duplicate faces, and igl_hhj's verdict. Exit 0 accepted, "
+                                   "duplicate faces, the repairs the drop-in principal_curvature would "
+                                   "make, and igl_hhj's verdict. Exit 0 accepted, "
                                    "1 rejected, 2 unreadable.")
     i.add_argument("mesh", metavar="MESH")
     i.set_defaults(func=_info)

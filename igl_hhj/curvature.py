@@ -388,7 +388,7 @@ def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary: str = "estim
 
 @kernels.with_large_call_heap
 def surface_hessian(V: Any, F: ArrayLike | None, w: ArrayLike, *, boundary_gradient: ArrayLike | None = None,
-                    solver: str = "auto", rtol: float = DEFAULT_RTOL) -> NDArray[np.float64]:
+                    solver: str = "auto", rtol: float = DEFAULT_RTOL, repair: bool = False) -> NDArray[np.float64]:
     """HHJ projection of the surface Hessian ∇_Γ∇_Γ w of a P1 function (Walker eq. 4.9).
 
     Parameters
@@ -400,6 +400,12 @@ def surface_hessian(V: Any, F: ArrayLike | None, w: ArrayLike, *, boundary_gradi
         True surface gradient of w at (at least) the boundary vertices: clamped
         boundary data (eq. 3.12's Σ_c term). Without it, the plain assembly.
     solver : {"auto", "cg", "direct"}
+    repair : bool, default False
+        True: a mesh refused for a repairable defect is repaired as in
+        :func:`shape_operator` (``w`` and ``boundary_gradient`` follow the
+        repaired vertices; one :class:`~igl_hhj.mesh.MeshWarning`); rows of
+        dropped faces are NaN, in the caller's F order.  False: such meshes
+        raise ``ValueError``.
 
     Returns
     -------
@@ -412,7 +418,14 @@ def surface_hessian(V: Any, F: ArrayLike | None, w: ArrayLike, *, boundary_gradi
     >>> igl_hhj.surface_hessian(V, F, V[:, 2] ** 2).shape   # (#F, 3, 3), one tensor per face
     (1280, 3, 3)
     """
-    mesh = as_mesh(V, F)
+    try:
+        mesh = as_mesh(V, F)
+    except MeshDefectError as exc:       # repairable: only on request (issue 24)
+        if not repair:
+            raise
+        from .repair import repaired_surface_hessian
+        return repaired_surface_hessian(surface_hessian, exc, V, F, w, dict(
+            boundary_gradient=boundary_gradient, solver=solver, rtol=rtol))
     w_arr = np.asarray(w)
     single = w_arr.ndim == 1
     if single:

@@ -17,6 +17,13 @@ a repeated vertex, and every component is orientable (``igl.bfs_orient``
 finds a consistent orientation); otherwise the report says why it is
 undefined.
 
+Repairs
+-------
+A mesh refused for a repairable defect (:class:`igl_hhj.mesh.MeshDefectError`)
+is run through :func:`igl_hhj.repair.repair_mesh`, as the drop-in
+``principal_curvature`` would: ``repairs`` holds its counts per kind and the
+report line names them, and whether the repaired mesh is then accepted.
+
 Boundary loops are the connected components of the graph of boundary edges
 (``scipy.sparse.csgraph``), which stays correct on inconsistently oriented or
 non-orientable meshes where ``igl.boundary_loop_all`` (it follows half-edge
@@ -28,7 +35,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .mesh import TriangleMesh, zero_area_faces
+import warnings
+
+from .mesh import MeshDefectError, MeshWarning, TriangleMesh, zero_area_faces
 
 __all__ = ["MeshReport", "mesh_report"]
 
@@ -68,6 +77,8 @@ class MeshReport:
     n_duplicate_faces: int | None = None
     bbox: tuple | None = None
     mean_edge_length: float | None = None
+    repairs: dict | None = None
+    repair_note: str = ""
 
     def lines(self):
         """The report as text lines (``igl-hhj info`` prints them)."""
@@ -112,6 +123,7 @@ class MeshReport:
                        + ", ".join(f"{x:.4g}" for x in hi) + "]")
         if self.mean_edge_length is not None:
             out.append(f"mean edge length  {self.mean_edge_length:.4g}")
+        out.append("drop-in repairs   " + ("none needed" if self.accepted else self.repair_note))
         out.append("verdict           " + ("accepted by igl_hhj" if self.accepted
                                            else f"rejected: {self.reason}"))
         return out
@@ -122,6 +134,33 @@ def _misoriented(E, uE, EMAP, count):
     forward = E[:, 0] == uE[EMAP, 0]
     n_forward = np.bincount(EMAP, weights=forward, minlength=len(uE))
     return (count == 2) & (n_forward != 1)
+
+
+def _repairs(V, F, defect):
+    """(summary or None, report text): what the drop-in's repair does to a refused mesh."""
+    if defect is None:
+        return None, "none possible (the drop-in refuses it too)"
+    from .repair import repair_mesh
+    try:
+        R = repair_mesh(V, F)
+    except (ValueError, TypeError) as exc:
+        return None, f"none possible (the drop-in refuses it: {exc})"
+    text = R.describe()
+    had = np.zeros(len(V), dtype=bool)
+    had[np.asarray(F, dtype=np.int64).ravel()] = True
+    had[R.vertex_map] = False
+    if had.any():
+        text += f"; {int(had.sum())} vertices left without a face (NaN)"
+    if not len(R.F):
+        return R.summary, text + "; no face left: principal_curvature gives NaN everywhere"
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", MeshWarning)      # split seams coincide on purpose
+            TriangleMesh(R.V, R.F)
+    except (ValueError, TypeError) as exc:
+        return R.summary, text + f"; the repaired mesh is still refused: {exc}"
+    return R.summary, text + ("; principal_curvature computes on the repaired mesh, the strict "
+                              "functions refuse it unless repair=True")
 
 
 def mesh_report(V, F):
@@ -142,13 +181,18 @@ def mesh_report(V, F):
 
     V = np.asarray(V)
     F = np.asarray(F)
+    defect = None
     try:
         TriangleMesh(V, F)
         accepted, reason = True, ""
+    except MeshDefectError as exc:
+        accepted, reason, defect = False, str(exc), exc
     except (ValueError, TypeError) as exc:
         accepted, reason = False, str(exc)
     nV, nF = len(V), len(F)
     rep = MeshReport(n_vertices=nV, n_faces=nF, accepted=accepted, reason=reason)
+    if not accepted:
+        rep.repairs, rep.repair_note = _repairs(V, F, defect)
     if V.ndim == 2 and V.shape[1] == 3 and nV and np.isfinite(V).all():
         rep.bbox = (V.min(axis=0), V.max(axis=0))
     if F.ndim != 2 or F.shape[1] != 3 or not np.issubdtype(F.dtype, np.integer):

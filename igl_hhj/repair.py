@@ -3,9 +3,10 @@
 results back to the caller's vertices and faces.
 
 The strict functions keep refusing such meshes; :func:`igl_hhj.principal_curvature`
-(and :func:`igl_hhj.shape_operator` with ``repair=True``) call :func:`repair_mesh`
-only after the strict validation has failed with a repairable
-:class:`igl_hhj.mesh.MeshDefectError`, so a clean mesh does no extra work.
+(and :func:`igl_hhj.shape_operator`, :func:`igl_hhj.surface_hessian` with
+``repair=True``) call :func:`repair_mesh` only after the strict validation has
+failed with a repairable :class:`igl_hhj.mesh.MeshDefectError`, so a clean mesh
+does no extra work.
 
 Repairs, in this order (all vectorised; loops run over components only)
 ----------------------------------------------------------------------
@@ -37,7 +38,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .mesh import MeshDefectError, MeshWarning, validate_faces, validate_vertices, zero_area_faces
+from .mesh import MeshWarning, validate_faces, validate_vertices, zero_area_faces
 
 __all__ = ["RepairedMesh", "repair_mesh", "vertex_values_to_caller", "face_values_to_caller",
            "REPAIR_KINDS"]
@@ -282,7 +283,8 @@ def in_repair():
     return _IN_REPAIR.get()
 
 
-PER_VERTEX_KWARGS = ("boundary_normals", "boundary_shape_operator", "simply_supported")
+PER_VERTEX_KWARGS = ("boundary_normals", "boundary_shape_operator", "simply_supported",
+                     "boundary_gradient")
 
 
 def _mesh_arrays(V, F):
@@ -296,17 +298,20 @@ def _mesh_arrays(V, F):
     return V, F
 
 
+def _vertex_rows(R, x, name):
+    """The rows of per-vertex data ``x`` (#V, ...) for the repaired mesh's vertices."""
+    x = np.asarray(x)
+    if x.ndim == 0 or x.shape[0] != R.n_vertices:
+        raise ValueError(f"{name} must have one row per vertex (#V = {R.n_vertices}), "
+                         f"got shape {x.shape}")
+    return x[R.vertex_map]
+
+
 def _map_kwargs(R, kwargs):
     kw = dict(kwargs)
     for name in PER_VERTEX_KWARGS:
-        x = kw.get(name)
-        if x is None:
-            continue
-        x = np.asarray(x)
-        if x.ndim == 0 or x.shape[0] != R.n_vertices:
-            raise ValueError(f"{name} must have one row per vertex (#V = {R.n_vertices}), "
-                             f"got shape {x.shape}")
-        kw[name] = x[R.vertex_map]
+        if kw.get(name) is not None:
+            kw[name] = _vertex_rows(R, kw[name], name)
     return kw
 
 
@@ -368,3 +373,21 @@ def repaired_shape_operator(fn, exc, V, F, kwargs):
     (S,) = face_values_to_caller(R, S)
     _warn(R, exc, "the shape operator")
     return S
+
+
+def repaired_surface_hessian(fn, exc, V, F, w, kwargs):
+    """:func:`igl_hhj.surface_hessian` with ``repair=True`` after a repairable defect:
+    ``w`` and ``boundary_gradient`` restricted to the repaired vertices, per-face
+    tensors in the caller's F order, NaN for dropped faces."""
+    if in_repair():
+        raise exc
+    R = repair_mesh(*_mesh_arrays(V, F))
+    w = _vertex_rows(R, w, "w")
+    kw = _map_kwargs(R, kwargs)
+    if len(R.F):
+        H = _run_repaired(fn, R.V, R.F, (w,), kw)
+    else:
+        H = np.zeros((0,) + np.shape(w)[1:] + (3, 3))
+    (H,) = face_values_to_caller(R, H)
+    _warn(R, exc, "the surface Hessian")
+    return H

@@ -46,6 +46,93 @@ def sequence(name, levels):
     raise KeyError(name)
 
 
+# --------------------------------------------------------------------------- defect meshes (issue 24)
+def fin(V, F, f=0):
+    """Glue a fin (one triangle sticking out radially) on the edge of corners 0, 1 of
+    face ``f``: that edge gets three faces.  Returns ``(V, F, [a, b])``."""
+    a, b = F[f][0], F[f][1]
+    tip = 1.5 * 0.5 * (V[a] + V[b])
+    return np.vstack([V, tip]), np.vstack([F, [[a, b, len(V)]]]), [a, b]
+
+
+def fins(V, F, faces):
+    """Glue one fin on the edge of corners 0, 1 of each face in ``faces``, its tip one edge
+    length above the edge midpoint along the face normal (radially out, 1.5 × the
+    midpoint, on a face without a normal; vectorised).  Returns ``(V, F)``."""
+    faces = np.asarray(faces, dtype=np.int64)
+    a, b, c = (F[faces, k] for k in range(3))
+    n = np.cross(V[b] - V[a], V[c] - V[a])
+    norm = np.linalg.norm(n, axis=1, keepdims=True)
+    m = 0.5 * (V[a] + V[b])
+    tip = np.where(norm > 0, m + np.linalg.norm(V[b] - V[a], axis=1, keepdims=True)
+                   * n / np.where(norm > 0, norm, 1.0), 1.5 * m)
+    new = len(V) + np.arange(len(faces))
+    return np.vstack([V, tip]), np.vstack([F, np.stack([a, b, new], axis=1)])
+
+
+def moebius(n=16, width=0.6, centre=(4.0, 0.0, 0.0)):
+    """A Möbius band of ``2 n`` vertices and ``2 n`` faces (non-orientable)."""
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+
+    def p(s):
+        r = 1 + s * np.cos(t / 2)
+        return np.stack([r * np.cos(t), r * np.sin(t), s * np.sin(t / 2)], axis=-1)
+
+    V = np.vstack([p(-width / 2), p(width / 2)]) + np.asarray(centre)
+    i = np.arange(n)
+    j = (i + 1) % n
+    top_j = np.where(i == n - 1, j, j + n)           # the half twist at the seam
+    bot_j = np.where(i == n - 1, j + n, j)
+    return V, np.vstack([np.stack([i, bot_j, top_j], 1), np.stack([i, top_j, i + n], 1)])
+
+
+DEFECTS = ("duplicate", "reversed duplicate", "flip", "fin", "zero-area face", "repeated corner",
+           "sliver", "hole", "moebius")
+"""The defect kinds of :func:`defect_mesh`."""
+
+
+@functools.cache
+def _small_meshes():
+    from igl_hhj import surfaces as su
+    return (su.icosphere(1), su.icosphere(2), su.torus_coarse(n_phi=12, n_t=6, amount=0.2))
+
+
+def defect_mesh(seed):
+    """A small sphere or torus with 1-3 seeded defects of :data:`DEFECTS` (each may
+    repeat). Returns ``(V, F, kinds)``."""
+    rng = np.random.default_rng(seed)
+    V, F = _small_meshes()[int(rng.integers(3))]
+    V, F = V.copy(), F.copy()
+    kinds = [str(k) for k in rng.choice(DEFECTS, int(rng.integers(1, 4)))]
+    for kind in kinds:
+        f = int(rng.integers(len(F)))
+        if kind == "duplicate":
+            F = np.vstack([F, F[f:f + 1]])
+        elif kind == "reversed duplicate":
+            F = np.vstack([F, F[f:f + 1, ::-1]])
+        elif kind == "flip":
+            F[f] = F[f, ::-1]
+        elif kind == "fin":
+            V, F = fins(V, F, [f])
+        elif kind == "zero-area face":
+            a, b = F[f][0], F[f][1]
+            V = np.vstack([V, 0.5 * (V[a] + V[b])])
+            F = np.vstack([F, [[a, b, len(V) - 1]]])
+        elif kind == "repeated corner":
+            F = np.vstack([F, [[F[f][0], F[f][0], F[f][1]]]])
+        elif kind == "sliver":
+            a, b, c = F[f]
+            m = 0.5 * (V[b] + V[c])
+            V[a] = m + 10.0 ** -rng.uniform(8, 16) * (V[a] - m)
+        elif kind == "hole":
+            F = np.delete(F, f, axis=0)
+        else:
+            Vm, Fm = moebius(int(rng.integers(8, 16)))
+            F = np.vstack([F, Fm + len(V)])
+            V = np.vstack([V, Vm])
+    return V, F, kinds
+
+
 def write_off(path, V, F):
     """Write (V, F) as an ascii OFF file with full float precision; returns ``path``."""
     lines = ["OFF", f"{len(V)} {len(F)} 0"] + [" ".join(map(repr, map(float, v))) for v in V]

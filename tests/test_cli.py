@@ -410,7 +410,7 @@ def moebius(n=8, w=0.3):
     (FLIPPED, "orientation", "inconsistent (1 edges traversed twice in the same direction), orientable"),
     (moebius(), "genus", "not defined: non-orientable"),
 ], ids=["nonmanifold", "degenerate", "flipped", "moebius"])
-def test_info_rejected_meshes(tmp_path, capsys, mesh, row, value):
+def test_info_rejected_meshes(tmp_path, capsys, mesh, row, value, request):
     path = write_off(tmp_path / "m.off", *mesh)
     with pytest.raises(ValueError) as exc:
         TriangleMesh(*igl.read_triangle_mesh(str(path)))
@@ -418,6 +418,28 @@ def test_info_rejected_meshes(tmp_path, capsys, mesh, row, value):
     assert code == 1 and cap.err == ""
     assert rows[row] == value
     assert rows["verdict"] == f"rejected: {exc.value}"
+    assert rows["drop-in repairs"].startswith(REPAIRS[request.node.callspec.id])
+
+
+REPAIRS = {   # what `info` says the drop-in's repair does (issue 24)
+    "nonmanifold": "2 vertex copies made to split non-manifold edges/vertices; principal_curvature "
+                   "computes on the repaired mesh",
+    "degenerate": "1 degenerate (zero-area or sliver) faces dropped; 1 vertices left without a face",
+    "flipped": "1 faces re-oriented to the majority orientation of their patch; principal_curvature",
+    "moebius": "16 faces of non-orientable (Möbius) patches removed; 16 vertices left without a face "
+               "(NaN); no face left",
+}
+
+
+def test_info_accepted_and_unrepairable_repair_rows(sphere, tmp_path, capsys):
+    path, _, _ = sphere
+    assert info(path, capsys)[1]["drop-in repairs"] == "none needed"
+    V, F = DEGENERATE
+    path = write_off(tmp_path / "tiny.off", V * 1e-62, F)       # repaired, but still too small
+    code, rows, _ = info(path, capsys)
+    assert code == 1 and "the repaired mesh is still refused: the mesh is too small" in rows["drop-in repairs"]
+    path = write_off(tmp_path / "tiny2.off", FLIPPED[0] * 1e-62, FLIPPED[1])   # refused before
+    assert info(path, capsys)[1]["drop-in repairs"] == "none possible (the drop-in refuses it too)"
 
 
 def test_info_mesh_with_bad_indices_is_rejected_not_crashed(tmp_path, capsys):

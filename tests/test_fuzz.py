@@ -5,7 +5,8 @@ returns NaN silently — either finite output (NaN only at the vertices listed i
 Families: perturbed spheres, random face subsets (boundaries, unreferenced
 vertices), slivers down to the validation threshold on small and on large
 (> 50k edges) meshes, folded / two-sided sheets, coordinate scales 1e-80 …
-1e77, int32/float32 inputs, and random mutations of valid OFF/OBJ/PLY/STL files
+1e77, int32/float32 inputs, 1,000 seeded meshes with the defects the drop-in
+repairs (compared with ``igl.principal_curvature``), and random mutations of valid OFF/OBJ/PLY/STL files
 run through ``igl-hhj info`` and ``igl-hhj curvature`` in a memory-capped child
 process.  Example counts are bounded (whole module ≈ 30–60 s); the number of
 inputs tried is counted in ``FUZZ_COUNTS`` and printed in pytest's summary.
@@ -19,11 +20,13 @@ import igl
 import numpy as np
 import pytest
 from cli_driver import check_outcome, run_capped
+from conftest import defect_mesh
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import igl_hhj
 from igl_hhj import cli
+from igl_hhj import repair as rp
 from igl_hhj.mesh import DEGENERATE_AREA_RTOL, MeshWarning, TriangleMesh
 from igl_hhj.surfaces import icosphere
 from igl_hhj.surfaces.meshing import square_grid
@@ -303,3 +306,51 @@ def test_valid_files_are_accepted(tmp_path):
         assert cli.main(["info", str(path)]) == 0, fmt
         V, F = igl.read_triangle_mesh(str(path))
         assert len(F) == len(F1), fmt
+
+
+def test_defect_meshes_against_libigl():
+    """1,000 seeded small spheres / tori with 1-3 defects each (duplicate and reversed
+    duplicate faces, flips, fins, zero-area faces, repeated corners, slivers, holes,
+    Möbius components; ``conftest.defect_mesh``), every 5th as float32 / int32: the
+    drop-in repairs them (issue 24) and its result has libigl's structure (shapes; float64
+    as libigl on float64 input), NaN rows are exactly ``bad_vertices``, at most one
+    MeshWarning, and a vertex that libigl gives finite values is bad only when the
+    repaired mesh leaves it no face or no tangent plane."""
+    n_repaired = 0
+    for seed in range(1000):
+        V, F, kinds = defect_mesh(seed)
+        FUZZ_COUNTS["defect meshes (drop-in repairs)"] += 1
+        if seed % 5 == 4:
+            V, F = V.astype(np.float32), F.astype(np.int32)
+        with warnings.catch_warnings(record=True) as rec:
+            warnings.simplefilter("always")
+            PD1, PD2, PV1, PV2, bad = out = igl_hhj.principal_curvature(V, F, solver="direct")
+        ws = [w for w in rec if issubclass(w.category, MeshWarning)]
+        assert len(ws) <= 1, (seed, kinds)
+        n_repaired += len(ws)
+        rows = np.column_stack([PD1, PD2, PV1, PV2])
+        assert rows.dtype == np.float64 and all(a.dtype == np.float64 for a in out[:4])
+        nan = ~np.isfinite(rows).all(axis=1)
+        assert np.isnan(rows[nan]).all() and np.flatnonzero(nan).tolist() == bad, (seed, kinds)
+        assert isinstance(bad, list) and all(type(i) is int for i in bad)
+        assert np.all(PV1[~nan] >= PV2[~nan])
+        try:
+            ref = igl.principal_curvature(V, F)
+        except Exception:                                  # libigl refused: only our structure
+            ref = None
+        if ref is None:
+            continue
+        for a, b in zip(out[:4], ref[:4]):
+            b = np.asarray(b)
+            assert a.shape == b.shape, (seed, kinds)
+            assert V.dtype != np.float64 or a.dtype == b.dtype, (seed, kinds)
+        igl_finite = np.isfinite(np.column_stack(ref[:4])).all(axis=1)
+        R = rp.repair_mesh(V, F)
+        explained = np.ones(len(V), dtype=bool)
+        if len(R.F):
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", MeshWarning)   # split seams coincide on purpose
+                m = TriangleMesh(R.V, R.F)
+            explained[R.vertex_map[m.referenced_vertices & ~m.folded_vertices]] = False
+        assert not (nan & igl_finite & ~explained).any(), (seed, kinds)
+    assert n_repaired > 900
