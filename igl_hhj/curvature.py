@@ -19,7 +19,7 @@ from . import intrinsic as _intrinsic
 from . import recovery as _recovery
 from .boundary_estimation import BOUNDARY_TREATMENTS, estimate_boundary_normals
 from .hhj import HHJProjection, clamped_load
-from .mesh import MeshDefectError, as_mesh, mark_bad_vertices, per_vertex_array
+from .mesh import MeshDefectError, _as_array, as_mesh, mark_bad_vertices, per_vertex_array
 from .solvers import DEFAULT_RTOL, HHJSystem
 
 __all__ = [
@@ -40,7 +40,7 @@ def _simply_supported_mask(edges, n_points, boundary_normals, boundary_shape_ope
     if simply_supported is not None:
         if boundary_shape_operator is None:
             raise ValueError("simply_supported needs boundary_shape_operator (the data on those edges)")
-        flag = np.asarray(simply_supported)
+        flag = _as_array(simply_supported, "simply_supported")   # a mask is refused, not dropped
         if flag.shape != (n_points,):
             raise ValueError(f"simply_supported must have shape ({n_points},), got {flag.shape}")
         if flag.dtype != bool:
@@ -426,7 +426,7 @@ def surface_hessian(V: Any, F: ArrayLike | None, w: ArrayLike, *, boundary_gradi
         from .repair import repaired_surface_hessian
         return repaired_surface_hessian(surface_hessian, exc, V, F, w, dict(
             boundary_gradient=boundary_gradient, solver=solver, rtol=rtol))
-    w_arr = np.asarray(w)
+    w_arr = _as_array(w, "w")             # np.asarray dropped a mask silently
     single = w_arr.ndim == 1
     if single:
         W = per_vertex_array(mesh, w_arr, "w")[:, None]
@@ -443,7 +443,7 @@ def surface_hessian(V: Any, F: ArrayLike | None, w: ArrayLike, *, boundary_gradi
     rhs = -kernels.jump_apply(mesh, W)                        # -B w, (#E, k)
     bnd = mesh.boundary_edges
     if boundary_gradient is not None and mesh.has_boundary:
-        G = np.asarray(boundary_gradient)
+        G = _as_array(boundary_gradient, "boundary_gradient")
         G = per_vertex_array(mesh, G, "boundary_gradient", (3,))[:, None, :] if single \
             else per_vertex_array(mesh, G, "boundary_gradient", (W.shape[1], 3))
         _data_rows(mesh, G, bnd, "boundary_gradient")

@@ -313,3 +313,29 @@ def test_message_hints():
     with pytest.raises(ValueError, match="F is a masked array"):
         igl_hhj.face_mean_curvature(V, Fm)
     igl_hhj.face_mean_curvature(np.ma.masked_array(V), F)          # nothing masked: accepted
+
+
+def test_masked_data_arrays_are_refused_not_unmasked():
+    """A masked w, boundary_gradient or simply_supported is refused (np.asarray would use
+    the values under the mask)."""
+    import numpy as np
+    import pytest
+
+    import igl_hhj
+    from igl_hhj.surfaces import icosphere
+    V, F = icosphere(2)
+    w = np.ma.masked_array(V[:, 0], mask=np.zeros(len(V), bool))
+    w.mask[3] = True
+    with pytest.raises(ValueError, match="w is a masked array"):
+        igl_hhj.surface_hessian(V, F, w)
+    keep = V[:, 2] < 0.5
+    Fo = F[keep[F].all(axis=1)]
+    G = np.ma.masked_array(np.zeros((len(V), 3)), mask=np.zeros((len(V), 3), bool))
+    G.mask[0, 0] = True
+    with pytest.raises(ValueError, match="boundary_gradient is a masked array"):
+        igl_hhj.surface_hessian(V, Fo, V[:, 0], boundary_gradient=G)
+    S = np.broadcast_to(np.eye(3), (len(V), 3, 3)).copy()
+    flag = np.ma.masked_array(np.ones(len(V), bool), mask=np.zeros(len(V), bool))
+    flag.mask[1] = True
+    with pytest.raises(ValueError, match="simply_supported is a masked array"):
+        igl_hhj.shape_operator(V, Fo, boundary_shape_operator=S, boundary_normals=V, simply_supported=flag)
