@@ -11,7 +11,7 @@ the caller's solver (as if it were the only component), and all the small ones
 together with the direct solver (which ``"auto"`` uses for each of them alone, and
 whose factor of a block diagonal matrix is block diagonal).  The vertex stage needs
 no split: its PCG keeps separate scalars per component
-(:func:`igl_hhj.kernels.connection_smoothing`).
+(:func:`igl_hhj.kernels.intrinsic_smoothing`).
 """
 from __future__ import annotations
 

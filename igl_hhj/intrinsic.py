@@ -42,7 +42,7 @@ a rotation per vertex, which multiplies z by a unit complex number; the Jacobi
 preconditioner is a scalar per vertex, so CG's iterates transform the same way).
 
 The compiled kernels (:func:`igl_hhj.kernels.intrinsic_patch_recovery`,
-:func:`igl_hhj.kernels.connection_smoothing`) compute the same; this module is
+:func:`igl_hhj.kernels.intrinsic_smoothing`) compute the same; this module is
 their readable numpy reference (``tests/test_intrinsic.py`` compares them).
 """
 from __future__ import annotations
@@ -265,11 +265,6 @@ def connection_laplacians(mesh: TriangleMesh, C, phases):
     return L, Lc
 
 
-def _kernel_coefficients(order):
-    from math import comb
-    return [comb(order, j) * (-1) ** (j + 1) for j in range(1, order + 1)]
-
-
 def smooth(mesh: TriangleMesh, X, N, weights, radius, *, steps=SMOOTHING_STEPS, order=SMOOTHING_ORDER,
            times=None):
     """Twiced implicit diffusion of the components (h, z) (numpy reference, sparse LU).
@@ -281,7 +276,7 @@ def smooth(mesh: TriangleMesh, X, N, weights, radius, *, steps=SMOOTHING_STEPS, 
     ``(I - (I - G)^order) X`` as a new (#V, 3) array (rows of unreferenced vertices 0).
     """
     import scipy.sparse.linalg as spla
-    from .recovery import smoothing_coefficients
+    from .recovery import _kernel_coefficients, smoothing_coefficients
     if times is None and not radius > 0:
         return X.copy()
     C, m = smoothing_coefficients(mesh, weights)
@@ -380,7 +375,7 @@ def vertex_stage(mesh: TriangleMesh, S, radius, *, rtol=None, maxiter=500, info=
     N : (#V, 3) the vertex normals (``mesh.vertex_normals``).
     """
     from . import kernels
-    from .recovery import QUALITY_FLOOR, SMOOTHING_PER_RADIUS, smoothing_coefficients
+    from .recovery import QUALITY_FLOOR, SMOOTHING_PER_RADIUS, _kernel_coefficients, smoothing_coefficients
     from .solvers import DEFAULT_RTOL
     rtol = DEFAULT_RTOL if rtol is None else rtol
     N = mesh.vertex_normals
@@ -395,13 +390,12 @@ def vertex_stage(mesh: TriangleMesh, S, radius, *, rtol=None, maxiter=500, info=
     srtol = smoothing_rtol(rtol)
     C0, m = smoothing_coefficients(mesh, w)
     phase = kernels.transport_phases(mesh, N)
-    X0 = X.copy()
     status, its, ncomp, r = kernels.intrinsic_smoothing(
         mesh, X, C0, m, phase, rough, radius, per_radius=SMOOTHING_PER_RADIUS, pilot_radius=PILOT_RADIUS,
         pilot_rtol=srtol, gain=ADAPTIVE_GAIN, power=ADAPTIVE_POWER, bounds=ADAPTIVE_RANGE,
         steps=SMOOTHING_STEPS, coefficients=_kernel_coefficients(SMOOTHING_ORDER), rtol=srtol, maxiter=maxiter)
     if info is not None:
         info.update(smoothing_iterations=its, components=ncomp, radius_median=float(np.median(r)))
-    if status != 0:          # a solve stalled (X unchanged): the direct reference
-        X = _smooth_reference(mesh, X0, N, w, rough, radius)
+    if status != 0:          # a solve stalled (the kernel left X unchanged): the direct reference
+        X = _smooth_reference(mesh, X, N, w, rough, radius)
     return X, N

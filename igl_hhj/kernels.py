@@ -40,8 +40,8 @@ __all__ = [
     "face_tensors", "lumped_vertex_recovery", "principal_2x2", "max_threads",
     "set_num_threads", "ell_indptr", "edge_morton_order", "recovery_weights", "patch_recovery",
     "tangent_projection6", "smooth_vertex_tensors", "face_metrics", "vertex_area_sums",
-    "intrinsic_patch_recovery", "connection_smoothing", "vertex_components", "transport_phases",
-    "adaptive_radius", "face_times", "principal_hz", "intrinsic_smoothing",
+    "intrinsic_patch_recovery", "vertex_components", "transport_phases",
+    "adaptive_radius", "principal_hz", "intrinsic_smoothing",
     "large_call_heap", "with_large_call_heap", "LARGE_CALL_HEAP",
 ]
 
@@ -384,6 +384,16 @@ def recovery_weights(mesh, quality_floor):
                                   float(quality_floor))
 
 
+def _recovery_args(mesh, S, N, w, name):
+    """The checked (#F, 3, 3) face tensors, (#V, 3) normals and (#F,) weights of a recovery kernel."""
+    S = _f64(S, "S", (3, 3))
+    N = _f64(N, "N", (3,))
+    w = _f64(w, "w")
+    if S.shape[0] != mesh.n_faces or N.shape[0] != mesh.n_vertices or w.shape != (mesh.n_faces,):
+        raise ValueError(f"{name}: S must be (#F, 3, 3), N (#V, 3) and w (#F,)")
+    return S, N, w
+
+
 def patch_recovery(mesh, S, N, w, keep_trace=True):
     """Patch recovery of face tensors at the vertices, tangent-projected, as 6 components.
 
@@ -391,11 +401,7 @@ def patch_recovery(mesh, S, N, w, keep_trace=True):
     ``S`` (#F, 3, 3), ``N`` (#V, 3) unit vertex normals, ``w`` (#F,) face weights →
     (#V, 6) float64 in the component order of :data:`igl_hhj.recovery._SYM`
     (rows of unreferenced vertices 0)."""
-    S = _f64(S, "S", (3, 3))
-    N = _f64(N, "N", (3,))
-    w = _f64(w, "w")
-    if S.shape[0] != mesh.n_faces or N.shape[0] != mesh.n_vertices or w.shape != (mesh.n_faces,):
-        raise ValueError("patch_recovery: S must be (#F, 3, 3), N (#V, 3) and w (#F,)")
+    S, N, w = _recovery_args(mesh, S, N, w, "patch_recovery")
     _threads()
     return _core.patch_recovery(mesh.V, mesh.F, S, N, w, _ref_mask(mesh), float(mesh.mean_edge_length),
                                 bool(keep_trace))
@@ -437,38 +443,10 @@ def intrinsic_patch_recovery(mesh, S, N, w):
     rough (#V,) the roughness of S_h around each vertex (reference
     :func:`igl_hhj.intrinsic.roughness`).  ``S`` (#F, 3, 3), ``N`` (#V, 3) unit vertex
     normals, ``w`` (#F,) face weights."""
-    S = _f64(S, "S", (3, 3))
-    N = _f64(N, "N", (3,))
-    w = _f64(w, "w")
-    if S.shape[0] != mesh.n_faces or N.shape[0] != mesh.n_vertices or w.shape != (mesh.n_faces,):
-        raise ValueError("intrinsic_patch_recovery: S must be (#F, 3, 3), N (#V, 3) and w (#F,)")
+    S, N, w = _recovery_args(mesh, S, N, w, "intrinsic_patch_recovery")
     _threads()
     return _core.intrinsic_patch_recovery(mesh.V, mesh.F, S, N, w, _ref_mask(mesh),
                                           float(mesh.mean_edge_length))
-
-
-def connection_smoothing(mesh, X, C, times, mass, phase, steps, coefficients, rtol, maxiter):
-    """Twiced implicit diffusion of the components ``X`` (#V, 3) = (h, Re z, Im z), in place.
-
-    Reference: :func:`igl_hhj.intrinsic.smooth`.  ``C`` (#F, 3) per-face stiffness entries,
-    ``times`` (#F,) the per-face diffusion time (the stiffness is ``C · times``), ``mass`` (#V,) the floored lumped mass,
-    ``phase`` (#E, 2) cos and sin of the spin-2 transport of each edge, ``coefficients``
-    binom(order, j)(-1)^(j+1).  Returns ``(status, iterations, components)``; status 0
-    when every PCG solve converged (else X is unchanged)."""
-    if not (isinstance(X, np.ndarray) and X.dtype == np.float64 and X.flags.c_contiguous
-            and X.shape == (mesh.n_vertices, 3)):
-        raise ValueError("connection_smoothing: X must be a C-contiguous float64 (#V, 3) array")
-    C = _f64(C, "C", (3,))
-    times = _f64(times, "times")
-    mass = _f64(mass, "mass")
-    phase = _f64(phase, "phase", (2,))
-    if C.shape[0] != mesh.n_faces or times.shape != (mesh.n_faces,) or mass.shape != (mesh.n_vertices,) \
-            or phase.shape[0] != mesh.n_edges:
-        raise ValueError("connection_smoothing: C must be (#F, 3), times (#F,), mass (#V,) and phase (#E, 2)")
-    _threads()
-    return _core.connection_smoothing(_i64(mesh.edges), _i64(mesh.edge_faces), _i64(mesh.edge_local_index),
-                                      C, times, mass, phase, X, int(steps), [float(c) for c in coefficients],
-                                      float(rtol), int(maxiter))
 
 
 def vertex_components(mesh):
@@ -495,16 +473,6 @@ def adaptive_radius(mesh, pilot, rough, radius, gain, power, lo, hi):
         raise ValueError("adaptive_radius: pilot must be (#V, 3) and rough (#V,)")
     return _core.adaptive_radius(mesh.V, mesh.F, pilot, rough, float(radius), float(gain), float(power),
                                  float(lo), float(hi))
-
-
-def face_times(mesh, radius, factor, steps):
-    """Per-face diffusion times ``(factor · r_T · h_T)² / steps`` (#F,), ``radius`` a number or
-    (#F,); reference :func:`igl_hhj.intrinsic.smoothing_times`."""
-    r = np.atleast_1d(_f64(radius, "radius"))
-    if r.shape not in ((1,), (mesh.n_faces,)):
-        raise ValueError("face_times: radius must be a number or (#F,)")
-    _threads()
-    return _core.face_times(mesh.V, mesh.F, r, float(factor), int(steps))
 
 
 def principal_hz(X, N):

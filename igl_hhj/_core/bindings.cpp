@@ -386,34 +386,6 @@ NB_MODULE(_hhj_core, m) {
         return nb::make_tuple(to_numpy(std::move(X), {(size_t)nV, 3}), to_numpy(std::move(rough), {(size_t)nV}));
     });
 
-    m.def("connection_smoothing", [](In<i64> E, In<i64> EF, In<i64> ELI, In<double> C, In<double> tface,
-                                     In<double> mass,
-                                     In<double> phase, nb::ndarray<double, nb::c_contig, nb::device::cpu> X,
-                                     int steps, std::vector<double> binom, double rtol, i64 maxiter) {
-        const i64 nV = X.shape(0), nE = E.shape(0);
-        need(X.ndim() == 2 && X.shape(1) == 3 && mass.shape(0) == (size_t)nV, "connection_smoothing: X, mass");
-        need(EF.shape(0) == (size_t)nE && ELI.shape(0) == (size_t)nE && C.ndim() == 2 && C.shape(1) == 3 &&
-             phase.ndim() == 2 && phase.shape(0) == (size_t)nE && phase.shape(1) == 2,
-             "connection_smoothing: topology shapes");
-        need(nV < ((i64)1 << 31), "connection_smoothing: at most 2**31 - 1 vertices");
-        const i64 nF = C.shape(0);
-        need(tface.ndim() == 1 && tface.shape(0) == (size_t)nF, "connection_smoothing: tface must be (#F,)");
-        const i64* e = E.data();
-        for (i64 q = 0; q < 2 * nE; ++q) need(e[q] >= 0 && e[q] < nV, "connection_smoothing: edge index out of range");
-        for (i64 q = 0; q < 2 * nE; ++q)
-            need(EF.data()[q] < nF && ELI.data()[q] < 3, "connection_smoothing: edge_faces out of range");
-        int status;
-        i64 iterations = 0, ngroups = 0;
-        {
-            nb::gil_scoped_release nogil;
-            hhj::ThreadBudget tb(nV);
-            status = hhj::connection_smoothing(nV, E.data(), nE, EF.data(), ELI.data(), C.data(), tface.data(),
-                                               nF, mass.data(), phase.data(), steps, binom, rtol, maxiter,
-                                               X.data(), tb.nt, &iterations, &ngroups);
-        }
-        return nb::make_tuple(status, iterations, ngroups);
-    });
-
     m.def("vertex_components", [](In<i64> E, i64 nV) {
         need(E.ndim() == 2 && E.shape(1) == 2, "vertex_components: E must be (#E, 2)");
         const i64 nE = E.shape(0);
@@ -451,22 +423,6 @@ NB_MODULE(_hhj_core, m) {
                                  r.data());
         }
         return to_numpy(std::move(r), {(size_t)nF});
-    });
-
-    m.def("face_times", [](In<double> V, In<i64> F, In<double> r, double factor, int steps) {
-        const i64 nF = F.shape(0);
-        need(F.ndim() == 2 && F.shape(1) == 3 && (r.shape(0) == (size_t)nF || r.shape(0) == 1), "face_times: shapes");
-        need(steps >= 1, "face_times: steps >= 1");
-        const i64 nV = V.shape(0);
-        for (i64 q = 0; q < 3 * nF; ++q) need(F.data()[q] >= 0 && F.data()[q] < nV, "face_times: index out of range");
-        std::vector<double> t(nF);
-        {
-            nb::gil_scoped_release nogil;
-            hhj::ThreadBudget tb(nF);
-            hhj::face_times(V.data(), F.data(), nF, r.data(), r.shape(0) == (size_t)nF && nF > 1 ? 1 : (r.shape(0) == 1 ? 0 : 1),
-                            factor, steps, t.data(), tb.nt);
-        }
-        return to_numpy(std::move(t), {(size_t)nF});
     });
 
     m.def("intrinsic_smoothing", [](In<double> V, In<i64> F, In<i64> E, In<i64> EF, In<i64> ELI, In<double> C,

@@ -195,10 +195,6 @@ i64 vertex_groups(i64 nV, const i64* E, i64 nE, std::vector<std::int32_t>& label
 void transport_phases(const double* N, i64 nV, const i64* E, i64 nE, double* phase, int nt);
 void adaptive_radius(const double* V, const i64* F, i64 nF, i64 nV, const double* P, const double* rough,
                      double radius, double gain, double power, double lo, double hi, double* r);
-int connection_smoothing(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* ELI, const double* C0,
-                         const double* tface, i64 nF, const double* m, const double* phase, int steps,
-                         const std::vector<double>& binom, double rtol, i64 maxiter, double* X, int nt,
-                         i64* iterations, i64* ngroups);
 void face_times(const double* V, const i64* F, i64 nF, const double* r, int r_stride, double factor,
                 int steps, double* t, int nt);
 void principal_hz(const double* X, const double* N, i64 n, double* PD1, double* PD2, double* PV1,

@@ -310,14 +310,12 @@ void face_times(const double* V, const i64* F, i64 nF, const double* r, int r_st
     }
 }
 
-// connection_smoothing: X (#V,3) <- (I - (I - G)^order) X in place, G = `steps` implicit
-// steps (M + L_t) Y = M Y_prev solved for the correction (M + L_t) dY = -L_t Y_prev.
-// C0 (#F,3) per-face stiffness entries (cotangent x reliability), tface (#F,) the per-face
-// time t_T (the stiffness is C0 t_T), m (#V,) the
-// floored lumped mass, phase (#E,2) (cos, sin) of r_e = e^{2 i rho_e} for edge (i < j).
-// The CG scalars are per connected component of the vertex graph (vertex_groups).
-// Returns 0, or the status of the first solve that did not converge (X is then
-// unchanged); *ngroups_out the number of components.
+// The smoothing: X (#V,3) <- (I - (I - G)^order) X, G = `steps` implicit steps
+// (M + L_t) Y = M Y_prev solved for the correction (M + L_t) dY = -L_t Y_prev.  C0 (#F,3)
+// per-face stiffness entries (cotangent x reliability), t (#F,) the per-face time (the
+// stiffness is C0 t), m (#V,) the floored lumped mass, phase (#E,2) (cos, sin) of
+// r_e = e^{2 i rho_e} for edge (i < j).  The CG scalars are per connected component of
+// the vertex graph (vertex_groups); a failed solve leaves X unchanged.
 namespace {
 
 // The structure of the smoothing system (built once per call) and its values for given
@@ -388,18 +386,6 @@ struct HZProblem {
 };
 
 }  // namespace
-
-int connection_smoothing(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* ELI, const double* C0,
-                         const double* tface, i64 nF, const double* m, const double* phase, int steps,
-                         const std::vector<double>& binom, double rtol, i64 maxiter, double* X, int nt,
-                         i64* iterations, i64* ngroups_out) {
-    (void)nF;
-    HZProblem P(nV, E, nE, EF, ELI, C0, m, phase);
-    *ngroups_out = P.ngroups;
-    P.fill(tface);
-    *iterations = 0;
-    return P.run(X, steps, binom, rtol, maxiter, nt, iterations);
-}
 
 // intrinsic_smoothing (intrinsic.vertex_stage): the pilot (one implicit step at
 // pilot_radius, to pilot_rtol), the adaptive per-face radius (adaptive_radius, written
