@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import functools
 import os
+import time
 from contextlib import contextmanager
 
 import numpy as np
@@ -80,15 +81,29 @@ def set_num_threads(n):
     _core.set_num_threads(_USER_THREADS)
 
 
+_CPU_COUNT = os.cpu_count() or 1
+# the load average changes on a scale of seconds: read at most this often (a drop-in call
+# on a tiny mesh makes ~10 kernel calls; reading it each time cost 8 % of a 12-face call)
+_LOAD_TTL = 0.25
+_load_cache = [-1.0, False]          # [monotonic time of the reading, busy]
+
+
+def _machine_busy():
+    now = time.monotonic()
+    if now - _load_cache[0] > _LOAD_TTL:
+        try:
+            busy = os.getloadavg()[0] >= _CPU_COUNT
+        except OSError:  # pragma: no cover - no load average on this platform
+            busy = False
+        _load_cache[0], _load_cache[1] = now, busy
+    return _load_cache[1]
+
+
 def _threads():
     """Apply the thread policy for the next kernel call (calling thread only)."""
     n = _USER_THREADS
-    if ADAPT_TO_LOAD and n > 1:
-        try:
-            if os.getloadavg()[0] >= (os.cpu_count() or 1):
-                n = 1
-        except OSError:  # pragma: no cover - no load average on this platform
-            pass
+    if ADAPT_TO_LOAD and n > 1 and _machine_busy():
+        n = 1
     _core.set_num_threads(n)
 
 
@@ -253,6 +268,29 @@ def jump_apply(mesh, W):
 def ell_indptr(n, width=5):
     """CSR row pointer of a fixed-width row format."""
     return np.arange(0, width * n + 1, width, dtype=np.int64)
+
+
+def envelope_ldl_solve(indptr, indices, data, R, resid_rtol):
+    """Direct solve ``A X = R`` of a small SPD CSR matrix by a dense envelope LDLᵀ
+    (no pivoting) in the compiled core, for the tiny systems where building scipy
+    sparse matrices and a QDLDL factor costs more than the factorisation itself.
+
+    Row ``i`` is stored from its first nonzero column on (the factor keeps that envelope):
+    O(Σ_i bandwidth_i²) flops, O(n²) memory, so only for n ≲ a few hundred
+    (:data:`igl_hhj.solvers.ENVELOPE_MAX`).  Reference: :func:`igl_hhj.solvers.cholesky_solve`.
+
+    Returns
+    -------
+    X : (n, k) float64
+    status : int, 0 solved (every column's relative residual ≤ ``resid_rtol``), 1 a pivot
+        ≤ 1e-13 max|a_ii| (numerically semi-definite: use a pivoted solver), 2 residual
+        too large, 3 a column index out of range
+    """
+    R = _f64(R, "R")
+    if R.ndim != 2:
+        raise ValueError(f"R must have shape (n, k), got {R.shape}")
+    return _core.envelope_ldl_solve(_i64(indptr), _i32(indices), _f64(data, "data"), R,
+                                    float(resid_rtol))
 
 
 def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,

@@ -45,3 +45,14 @@ def test_profile_stages_follows_the_default_drop_in():
     assert out["large-call heap scope"] is False          # 1280 faces: below glibc's ceiling
     assert out["smoothing iterations"] > 0 and out["HHJ solver"] in ("direct", "cg")
     assert out["minor page faults"] == sum(out["page faults per stage"].values())
+
+
+def test_tiny_study_reports_every_tiny_mesh():
+    """--tiny: the fixed-cost table covers closed and open meshes under 1,000 faces (plus the
+    1,280-face icosphere(3) as the upper end) and states the ≤ 2× target."""
+    rows = speed.tiny_study(calls=2)
+    assert [r["mesh"] for r in rows][:2] == ["octahedron", "cube"]
+    assert any(r["mesh"] == "open grid" for r in rows)
+    assert all(r["faces"] <= 1280 and r["libigl_ms"] > 0 and r["hhj_ms"] > 0 for r in rows)
+    assert all(abs(r["ratio"] - r["hhj_ms"] / r["libigl_ms"]) < 1e-12 for r in rows)
+    assert "target ≤ 2" in speed.tiny_markdown(rows)

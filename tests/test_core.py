@@ -23,7 +23,7 @@ from igl_hhj.errors import SolverError
 from igl_hhj.hhj import (
     HHJProjection, face_schwarz_preconditioner, face_tensors, jump_matrix, mass_matrix, solve_spd,
 )
-from igl_hhj.mesh import DEGENERATE_AREA_RTOL, TriangleMesh, topology_reference
+from igl_hhj.mesh import DEGENERATE_AREA_RTOL, TriangleMesh, as_mesh, topology_reference
 from igl_hhj.solvers import HHJSystem
 from igl_hhj.surfaces import Sphere, icosphere, jitter_tangentially
 from igl_hhj.surfaces.boundary_data import exact_boundary_normals, exact_boundary_shape_operator
@@ -692,3 +692,41 @@ def test_dropin_frees_the_face_tensors_before_its_memory_peak(monkeypatch):
     ref = curvature.dropin_vertex_values(m, igl_hhj.shape_operator(m), 5)
     for a, b in zip(ref, out):
         np.testing.assert_array_equal(a, b)
+
+
+def test_envelope_ldl_agrees_with_the_sparse_direct_solve():
+    """The compiled small-system solve (tiny meshes) is the sparse direct solve to round-off,
+    refuses a semi-definite matrix (status 1: the caller pivots) and a bad index (status 3)."""
+    from igl_hhj import solvers
+    V, F = icosphere(1)
+    rng = np.random.default_rng(3)
+    mesh = as_mesh(V + 0.02 * rng.standard_normal(V.shape), F)
+    system = solvers.HHJSystem(mesh)
+    assert system.n <= solvers.ENVELOPE_MAX
+    R = rng.standard_normal((system.n, 3))
+    X, status = kernels.envelope_ldl_solve(system.indptr, system._cols_flat, system.A.ravel(), R, 1e-8)
+    assert status == 0
+    Y = solvers.cholesky_solve(system.csr(), R)
+    assert np.abs(X - Y).max() <= 1e-12 * np.abs(Y).max()
+    # a singular matrix: the unpivoted factorisation stops and says so
+    indptr = np.array([0, 2, 4])
+    cols = np.array([0, 1, 0, 1], dtype=np.int32)
+    _, status = kernels.envelope_ldl_solve(indptr, cols, np.array([1.0, 1.0, 1.0, 1.0]), np.ones((2, 1)), 1e-8)
+    assert status == 1
+    _, status = kernels.envelope_ldl_solve(indptr, np.array([0, 5, 0, 1], dtype=np.int32),
+                                           np.array([2.0, 1.0, 1.0, 2.0]), np.ones((2, 1)), 1e-8)
+    assert status == 3
+
+
+def test_tiny_meshes_take_the_envelope_solve_and_match_the_reference(monkeypatch):
+    """A drop-in call on a tiny mesh uses the compiled envelope solve, never scipy's
+    sparse factorisation, and its shape operator is the numpy reference's."""
+    from igl_hhj import curvature, solvers
+    V, F = icosphere(1)
+    called = []
+    monkeypatch.setattr(solvers, "cholesky_solve", lambda *a, **k: called.append(1))
+    S = curvature.shape_operator(V, F)
+    assert not called
+    monkeypatch.undo()
+    ref = curvature._shape_operator_reference(as_mesh(V, F))
+    assert np.abs(S - ref).max() <= 1e-10 * np.abs(ref).max()

@@ -257,6 +257,23 @@ NB_MODULE(_hhj_core, m) {
                               res.relres);
     });
 
+    m.def("envelope_ldl_solve", [](In<i64> Ap, In<std::int32_t> Ai, In<double> Ax, In<double> R,
+                                   double resid_rtol) {
+        need(R.ndim() == 2, "envelope_ldl_solve: R must be (n, k)");
+        const i64 n = R.shape(0);
+        const int k = (int)R.shape(1);
+        need(Ap.shape(0) == (size_t)n + 1 && Ai.shape(0) == Ax.shape(0) && Ap.data()[0] == 0 &&
+             Ap.data()[n] == (i64)Ai.shape(0), "envelope_ldl_solve: CSR arrays do not match R");
+        for (i64 i = 0; i < n; ++i) need(Ap.data()[i] <= Ap.data()[i + 1], "envelope_ldl_solve: indptr not monotone");
+        std::vector<double> X((size_t)n * k);
+        int status;
+        {
+            nb::gil_scoped_release nogil;
+            status = hhj::envelope_ldl_solve(n, k, Ap.data(), Ai.data(), Ax.data(), R.data(), X.data(), resid_rtol);
+        }
+        return nb::make_tuple(to_numpy(std::move(X), {(size_t)n, (size_t)k}), status);
+    });
+
     m.def("shape_operator_faces", [](In<double> V, In<i64> F, In<i64> FE, In<double> s) {
         const i64 nF = F.shape(0);
         need(s.ndim() == 2 && s.shape(1) == 3, "shape_operator_faces: s must be (#E, 3)");

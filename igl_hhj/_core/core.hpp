@@ -250,6 +250,9 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
                     i64 probe_iter, double max_predicted, int nt,
                     const SubdomainSolve* sub = nullptr, bool coupled = false);
 
+int envelope_ldl_solve(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const double* Ax,
+                       const double* R, double* X, double resid_rtol);
+
 // Large-call heap scope (heap.cpp): raise glibc's mmap threshold while open; the last
 // exit restores glibc's 32 MiB ceiling and trims.  enter returns whether it is raised,
 // exit whether this exit restored and trimmed.

@@ -2,7 +2,7 @@
 measured in the same run.
 
     python -m igl_hhj.benchmarks.speed [--quick] [--repeat 3] [--meshes DIR] [--out DIR]
-    python -m igl_hhj.benchmarks.speed --rtol-study | --sliver-study | --factor-study | --profile 'icosphere(8)'
+    python -m igl_hhj.benchmarks.speed --rtol-study | --sliver-study | --factor-study | --tiny | --profile 'icosphere(8)'
 
 Meshes: icosphere(7) (328k faces) and icosphere(8) (1.31M), a jittered ellipsoid at
 82k / 328k / 1.31M faces (linear-scaling check), Walker's torus from a perturbed grid
@@ -444,6 +444,66 @@ def markdown(rows):
     return "\n".join(lines)
 
 
+def tiny_meshes():
+    """The fixed-cost meshes of :func:`tiny_study`: ``[(name, V, F)]`` with 8-1,280 faces,
+    closed and open (a cube, the icospheres 0-3, a coarse torus, an open jittered grid)."""
+    from ..surfaces import icosphere, square_grid
+    V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]], float)
+    F = np.array([[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4], [1, 2, 6], [1, 6, 5],
+                  [2, 3, 7], [2, 7, 6], [3, 0, 4], [3, 4, 7]])
+    out = [("octahedron", *_octahedron()), ("cube", V, F)]
+    out += [(f"icosphere({n})", *icosphere(n)) for n in range(4)]
+    u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 9)[:-1], np.linspace(0, 2 * np.pi, 7)[:-1], indexing="ij")
+    Vt = np.c_[((2 + np.cos(v)) * np.cos(u)).ravel(), ((2 + np.cos(v)) * np.sin(u)).ravel(), np.sin(v).ravel()]
+    i, j = np.meshgrid(np.arange(8), np.arange(6), indexing="ij")
+    a, b = i * 6 + j, ((i + 1) % 8) * 6 + j
+    c, d = ((i + 1) % 8) * 6 + (j + 1) % 6, i * 6 + (j + 1) % 6
+    Ft = np.r_[np.c_[a.ravel(), b.ravel(), c.ravel()], np.c_[a.ravel(), c.ravel(), d.ravel()]]
+    out.append(("torus 96", Vt, Ft))
+    P, Fg = square_grid(8, amount=0.3, seed=3)
+    out.append(("open grid", np.c_[P, 0.3 * P[:, 0] * P[:, 1]], Fg))
+    return out
+
+
+def _octahedron():
+    V = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], float)
+    F = np.array([[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]])
+    return V, F
+
+
+def tiny_study(calls=400):
+    """Fixed cost per call on meshes under 1,000 faces (issue 24: ≤ 2× libigl's time).
+
+    Each mesh: the median over ``calls`` interleaved calls of ``igl.principal_curvature``
+    and of the drop-in (radius 5, warm: the first calls are dropped).  Returns rows
+    ``{mesh, faces, libigl_ms, hhj_ms, ratio}`` with ``ratio = t_hhj / t_libigl`` (the
+    target is ≤ 2)."""
+    import igl
+
+    import igl_hhj
+    rows = []
+    for name, V, F in tiny_meshes():
+        for _ in range(20):
+            igl.principal_curvature(V, F)
+            igl_hhj.principal_curvature(V, F)
+        t = np.empty((calls, 2))
+        for k in range(calls):
+            for j, f in enumerate((igl.principal_curvature, igl_hhj.principal_curvature)):
+                t0 = time.perf_counter()
+                f(V, F)
+                t[k, j] = time.perf_counter() - t0
+        a, b = np.median(t, axis=0) * 1e3
+        rows.append({"mesh": name, "faces": len(F), "libigl_ms": a, "hhj_ms": b, "ratio": b / a})
+    return rows
+
+
+def tiny_markdown(rows):
+    lines = ["| mesh | faces | libigl ms | igl_hhj ms | igl_hhj / libigl (target ≤ 2) |", "|---|---|---|---|---|"]
+    lines += [f"| {r['mesh']} | {r['faces']} | {r['libigl_ms']:.3f} | {r['hhj_ms']:.3f} | {r['ratio']:.2f} |"
+              for r in rows]
+    return "\n".join(lines)
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--quick", action="store_true", help="three small meshes (seconds)")
@@ -463,7 +523,12 @@ def main(argv=None):
                         "drop-in on one mesh, e.g. 'icosphere(8)'")
     p.add_argument("--rtol-study", action="store_true",
                    help="only the tolerance study (PCG iterations and error vs rtol)")
+    p.add_argument("--tiny", action="store_true",
+                   help="only the fixed cost per call on meshes under 1,000 faces (median of interleaved calls)")
     a = p.parse_args(argv)
+    if a.tiny:
+        print(tiny_markdown(tiny_study()))
+        return
     if a.sliver_study:
         rows = sliver_study(mesh_dir=a.meshes)
         lines = ["| mesh | faces | sliver angle | sliver DOFs | PCG its | CPU s |", "|---|---|---|---|---|---|"]
