@@ -23,6 +23,7 @@ smoothing scale of the drop-in), :mod:`igl_hhj.boundary_estimation` (data-free b
 """
 import importlib
 import pkgutil
+from typing import TYPE_CHECKING, Any
 
 # Run from a source checkout (e.g. `python -m pytest` in the repository, whose folder
 # shadows the installed package), the compiled core igl_hhj._hhj_core lives only in the
@@ -54,7 +55,23 @@ __all__ = [
 ]
 
 
-def __getattr__(name):
+if TYPE_CHECKING:
+    # Static checkers (mypy, pyright, IDEs) see every public name with its real type;
+    # at run time nothing here is imported and ``__getattr__`` below resolves the
+    # names on first use.  Keep in step with _LAZY_MODULES / _LAZY_ATTRS
+    # (tests/test_typing.py checks that the two agree).
+    from . import (baselines, benchmarks, biharmonic, boundary_estimation, cli, convergence, curvature,
+                   demos, errors, hhj, interop, mesh, mesh_io, mesh_report, recovery, regge, repair,
+                   surfaces, viewer)
+    from .biharmonic import BiharmonicSolver, biharmonic_solve
+    from .curvature import (boundary_treatment, face_gaussian_curvature, face_mean_curvature,
+                            face_principal_curvature, principal_curvature, principal_from_shape_operator,
+                            shape_operator, surface_hessian)
+    from .errors import SolverDidNotConverge, SolverError
+    from .mesh import TriangleMesh, validate_mesh
+
+
+def __getattr__(name: str) -> Any:
     """Import submodules (and their headline functions) on first use."""
     if name in _LAZY_MODULES:
         return importlib.import_module(f".{name}", __name__)
@@ -65,5 +82,5 @@ def __getattr__(name):
     raise AttributeError(f"module 'igl_hhj' has no attribute {name!r}")
 
 
-def __dir__():
+def __dir__() -> list[str]:
     return sorted(set(globals()) | _LAZY_MODULES | set(_LAZY_ATTRS))

@@ -90,8 +90,9 @@ def _resolve_boundary(mesh, boundary, boundary_normals, boundary_shape_operator)
     return estimate_boundary_normals(mesh), "estimate"
 
 
-def boundary_treatment(V, F, *, boundary="estimate", boundary_normals=None,
-                       boundary_shape_operator=None):
+def boundary_treatment(V: Any, F: ArrayLike | None, *, boundary: str = "estimate",
+                       boundary_normals: ArrayLike | None = None,
+                       boundary_shape_operator: ArrayLike | None = None) -> str:
     """Which boundary treatment :func:`shape_operator` applies to this mesh and these arguments.
 
     Returns
