@@ -5,7 +5,10 @@ Core (needs only libigl, numpy, scipy; imported on first use):
 * :func:`shape_operator` — Walker's surface-HHJ shape operator S_h, one tensor per face;
 * :func:`surface_hessian` — HHJ projection of the surface Hessian of a P1 function;
 * :func:`principal_curvature` — drop-in replacement for ``igl.principal_curvature``;
-* :func:`face_principal_curvature`, :func:`face_mean_curvature`, :func:`face_gaussian_curvature`.
+* :func:`face_principal_curvature`, :func:`face_mean_curvature`, :func:`face_gaussian_curvature`;
+* :func:`curvature_of` — one quantity (mean, gauss, k1, k2, directions) per vertex or per
+  face of ``(V, F)`` or a trimesh / pyvista / meshio mesh, as arrays (not ``curvature``:
+  that name is the submodule :mod:`igl_hhj.curvature`).
 
 Submodules (imported on first use): :mod:`igl_hhj.regge` (Regge metrics and
 lifted distributional Gauss curvature), :mod:`igl_hhj.biharmonic` (mixed P1
@@ -41,8 +44,8 @@ _LAZY_MODULES = {"regge", "biharmonic", "baselines", "viewer", "surfaces", "benc
 # no numpy/scipy import.
 _LAZY_ATTRS = {"biharmonic_solve": "biharmonic", "BiharmonicSolver": "biharmonic",
                **{name: "curvature" for name in (
-                   "boundary_treatment", "face_gaussian_curvature", "face_mean_curvature", "face_principal_curvature",
-                   "principal_curvature", "principal_from_shape_operator", "shape_operator",
+                   "boundary_treatment", "curvature_of", "face_gaussian_curvature", "face_mean_curvature",
+                   "face_principal_curvature", "principal_curvature", "principal_from_shape_operator", "shape_operator",
                    "surface_hessian")},
                "SolverError": "errors", "SolverDidNotConverge": "errors",
                "TriangleMesh": "mesh", "validate_mesh": "mesh"}
@@ -50,7 +53,7 @@ _LAZY_ATTRS = {"biharmonic_solve": "biharmonic", "BiharmonicSolver": "biharmonic
 __all__ = [
     "shape_operator", "surface_hessian", "principal_curvature",
     "face_principal_curvature", "face_mean_curvature", "face_gaussian_curvature",
-    "principal_from_shape_operator", "boundary_treatment", "TriangleMesh", "validate_mesh",
+    "principal_from_shape_operator", "boundary_treatment", "curvature_of", "TriangleMesh", "validate_mesh",
     "biharmonic_solve", "BiharmonicSolver", "SolverError", "SolverDidNotConverge",
 ]
 
@@ -64,9 +67,9 @@ if TYPE_CHECKING:
                    demos, errors, hhj, interop, mesh, mesh_io, mesh_report, recovery, regge, repair,
                    surfaces, viewer)
     from .biharmonic import BiharmonicSolver, biharmonic_solve
-    from .curvature import (boundary_treatment, face_gaussian_curvature, face_mean_curvature,
-                            face_principal_curvature, principal_curvature, principal_from_shape_operator,
-                            shape_operator, surface_hessian)
+    from .curvature import (boundary_treatment, curvature_of, face_gaussian_curvature,
+                            face_mean_curvature, face_principal_curvature, principal_curvature,
+                            principal_from_shape_operator, shape_operator, surface_hessian)
     from .errors import SolverDidNotConverge, SolverError
     from .mesh import TriangleMesh, validate_mesh
 
