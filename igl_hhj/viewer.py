@@ -150,7 +150,7 @@ class Registration:
             return None
         try:
             return _png_bytes(to_image(self, size=REPR_PNG_SIZE))
-        except (ViewerUnavailable, ValueError, RuntimeError):
+        except (RuntimeError, ValueError):      # ViewerUnavailable is a RuntimeError
             return None
 
     def __repr__(self):
