@@ -5,7 +5,10 @@ Core (needs only libigl, numpy, scipy; imported on first use):
 * :func:`shape_operator` — Walker's surface-HHJ shape operator S_h, one tensor per face;
 * :func:`surface_hessian` — HHJ projection of the surface Hessian of a P1 function;
 * :func:`principal_curvature` — drop-in replacement for ``igl.principal_curvature``;
-* :func:`face_principal_curvature`, :func:`face_mean_curvature`, :func:`face_gaussian_curvature`.
+* :func:`face_principal_curvature`, :func:`face_mean_curvature`, :func:`face_gaussian_curvature`;
+* :func:`curvature_of` — one quantity (mean, gauss, k1, k2, directions) per vertex or per
+  face of ``(V, F)`` or a trimesh / pyvista / meshio mesh, as arrays (not ``curvature``:
+  that name is the submodule :mod:`igl_hhj.curvature`).
 
 Submodules (imported on first use): :mod:`igl_hhj.regge` (Regge metrics and
 lifted distributional Gauss curvature), :mod:`igl_hhj.biharmonic` (mixed P1
@@ -23,6 +26,7 @@ smoothing scale of the drop-in), :mod:`igl_hhj.boundary_estimation` (data-free b
 """
 import importlib
 import pkgutil
+from typing import TYPE_CHECKING, Any
 
 # Run from a source checkout (e.g. `python -m pytest` in the repository, whose folder
 # shadows the installed package), the compiled core igl_hhj._hhj_core lives only in the
@@ -40,8 +44,8 @@ _LAZY_MODULES = {"regge", "biharmonic", "baselines", "viewer", "surfaces", "benc
 # no numpy/scipy import.
 _LAZY_ATTRS = {"biharmonic_solve": "biharmonic", "BiharmonicSolver": "biharmonic",
                **{name: "curvature" for name in (
-                   "boundary_treatment", "face_gaussian_curvature", "face_mean_curvature", "face_principal_curvature",
-                   "principal_curvature", "principal_from_shape_operator", "shape_operator",
+                   "boundary_treatment", "curvature_of", "face_gaussian_curvature", "face_mean_curvature",
+                   "face_principal_curvature", "principal_curvature", "principal_from_shape_operator", "shape_operator",
                    "surface_hessian")},
                "SolverError": "errors", "SolverDidNotConverge": "errors",
                "TriangleMesh": "mesh", "validate_mesh": "mesh"}
@@ -49,12 +53,28 @@ _LAZY_ATTRS = {"biharmonic_solve": "biharmonic", "BiharmonicSolver": "biharmonic
 __all__ = [
     "shape_operator", "surface_hessian", "principal_curvature",
     "face_principal_curvature", "face_mean_curvature", "face_gaussian_curvature",
-    "principal_from_shape_operator", "boundary_treatment", "TriangleMesh", "validate_mesh",
+    "principal_from_shape_operator", "boundary_treatment", "curvature_of", "TriangleMesh", "validate_mesh",
     "biharmonic_solve", "BiharmonicSolver", "SolverError", "SolverDidNotConverge",
 ]
 
 
-def __getattr__(name):
+if TYPE_CHECKING:
+    # Static checkers (mypy, pyright, IDEs) see every public name with its real type;
+    # at run time nothing here is imported and ``__getattr__`` below resolves the
+    # names on first use.  Keep in step with _LAZY_MODULES / _LAZY_ATTRS
+    # (tests/test_typing.py checks that the two agree).
+    from . import (baselines, benchmarks, biharmonic, boundary_estimation, cli, convergence, curvature,
+                   demos, errors, hhj, interop, mesh, mesh_io, mesh_report, recovery, regge, repair,
+                   surfaces, viewer)
+    from .biharmonic import BiharmonicSolver, biharmonic_solve
+    from .curvature import (boundary_treatment, curvature_of, face_gaussian_curvature,
+                            face_mean_curvature, face_principal_curvature, principal_curvature,
+                            principal_from_shape_operator, shape_operator, surface_hessian)
+    from .errors import SolverDidNotConverge, SolverError
+    from .mesh import TriangleMesh, validate_mesh
+
+
+def __getattr__(name: str) -> Any:
     """Import submodules (and their headline functions) on first use."""
     if name in _LAZY_MODULES:
         return importlib.import_module(f".{name}", __name__)
@@ -65,5 +85,5 @@ def __getattr__(name):
     raise AttributeError(f"module 'igl_hhj' has no attribute {name!r}")
 
 
-def __dir__():
+def __dir__() -> list[str]:
     return sorted(set(globals()) | _LAZY_MODULES | set(_LAZY_ATTRS))

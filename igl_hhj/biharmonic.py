@@ -74,7 +74,10 @@ up to :data:`CHOLMOD_MIN_UNKNOWNS` unknowns and by CHOLMOD (cholespy) above.
 """
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
@@ -342,7 +345,8 @@ class BiharmonicSolver:
     Stein, Grinspun, Jacobson, Wardetzky (2022), eq. (1.5), (6.1)–(6.5).
     """
 
-    def __init__(self, V, F=None, *, bc="clamped", mass="full", solver="auto", rtol=1e-10):
+    def __init__(self, V: Any, F: ArrayLike | None = None, *, bc: str = "clamped", mass: str = "full",
+                 solver: str = "auto", rtol: float = 1e-10) -> None:
         self.mesh = as_mesh(V, F)
         self.bc = _check_choice(bc, "bc", BOUNDARY_CONDITIONS)
         self.mass = _check_choice(mass, "mass", MASS_TYPES)
@@ -445,7 +449,8 @@ class BiharmonicSolver:
         self._Mload_row = np.asarray(self.M_load[A][:, A].sum(axis=0)).ravel()
 
     # ------------------------------------------------------------ solve
-    def solve(self, f, *, g=None, q=None, w=None, project_mean=False):
+    def solve(self, f: Any, *, g: Any = None, q: Any = None, w: Any = None,
+              project_mean: bool = False) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Solve ``Δ²u = f`` with the factorised system.
 
         Parameters
@@ -618,8 +623,9 @@ class BiharmonicSolver:
 
 
 @kernels.with_large_call_heap
-def biharmonic_solve(V, F, f, *, bc="clamped", mass="full", g=None, q=None, w=None,
-                     project_mean=False, solver="auto", rtol=1e-10):
+def biharmonic_solve(V: Any, F: ArrayLike | None, f: Any, *, bc: str = "clamped", mass: str = "full",
+                     g: Any = None, q: Any = None, w: Any = None, project_mean: bool = False,
+                     solver: str = "auto", rtol: float = 1e-10) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Solve ``Δ²u = f`` on a triangle mesh with the mixed P1 method (Stein et al. 2022).
 
     One-shot wrapper around :class:`BiharmonicSolver`; use the class to reuse

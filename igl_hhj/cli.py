@@ -583,7 +583,7 @@ def _one_line(text):
     return " ".join(str(text).split()) or "(no message)"
 
 
-_WARNED = set()
+_WARNED: set[str] = set()
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None):

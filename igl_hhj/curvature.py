@@ -7,7 +7,7 @@ operator ``P / R`` and principal curvatures ``+1/R``.
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Literal, overload
 
 import igl  # noqa: F401  (imported with the public API, not inside the first call: issue 16)
 import numpy as np
@@ -27,7 +27,7 @@ __all__ = [
     "face_principal_curvature", "face_mean_curvature", "face_gaussian_curvature",
     "principal_from_shape_operator", "vertex_shape_operator", "vertex_principal_curvature",
     "check_principal_curvature_args", "boundary_treatment", "smoothed_face_shape_operator",
-    "dropin_vertex_values",
+    "dropin_vertex_values", "curvature_of", "CURVATURE_KINDS", "CURVATURE_KIND_ALIASES", "CURVATURE_PER",
 ]
 
 
@@ -90,8 +90,9 @@ def _resolve_boundary(mesh, boundary, boundary_normals, boundary_shape_operator)
     return estimate_boundary_normals(mesh), "estimate"
 
 
-def boundary_treatment(V, F, *, boundary="estimate", boundary_normals=None,
-                       boundary_shape_operator=None):
+def boundary_treatment(V: Any, F: ArrayLike | None, *, boundary: str = "estimate",
+                       boundary_normals: ArrayLike | None = None,
+                       boundary_shape_operator: ArrayLike | None = None) -> str:
     """Which boundary treatment :func:`shape_operator` applies to this mesh and these arguments.
 
     Returns
@@ -788,3 +789,116 @@ def dropin_vertex_values(mesh, S, radius, rtol=DEFAULT_RTOL):
     PD1, PD2, PV1, PV2, bad = mark_bad_vertices(mesh, PD1, PD2, PV1, PV2, copy=False)
     return (np.ascontiguousarray(PD1), np.ascontiguousarray(PD2),
             np.ascontiguousarray(PV1), np.ascontiguousarray(PV2), bad)
+
+
+# --------------------------------------------------------------------------- one call, any mesh
+CURVATURE_KINDS = ("mean", "gauss", "k1", "k2", "directions")
+"""The quantities of :func:`curvature_of` (canonical names)."""
+CURVATURE_KIND_ALIASES = {"gaussian": "gauss", "H": "mean", "K": "gauss"}
+"""Other accepted names: pyvista's ``"gaussian"``, and ``"H"`` / ``"K"`` as in
+:class:`igl_hhj.baselines.CurvatureEstimate`, the viewer and ``igl-hhj curvature --quantity``."""
+CURVATURE_PER = ("vertex", "face")
+"""Where :func:`curvature_of` gives values."""
+
+_Scalar = Literal["mean", "gauss", "gaussian", "k1", "k2", "H", "K"]
+
+
+def _curvature_kind(kind):
+    if isinstance(kind, str):
+        kind = CURVATURE_KIND_ALIASES.get(kind, kind)
+        if kind in CURVATURE_KINDS:
+            return kind
+    raise ValueError(f"kind must be one of {', '.join(map(repr, CURVATURE_KINDS))} (aliases: "
+                     f"{', '.join(f'{a!r} = {c!r}' for a, c in CURVATURE_KIND_ALIASES.items())}), got {kind!r}")
+
+
+@overload
+def curvature_of(mesh_or_V: Any, F: ArrayLike | None = None, kind: _Scalar = "mean",
+                 per: Literal["vertex", "face"] = "vertex", **kwargs: Any) -> NDArray[np.float64]: ...
+
+
+@overload
+def curvature_of(mesh_or_V: Any, F: ArrayLike | None, kind: Literal["directions"],
+                 per: Literal["vertex", "face"] = "vertex",
+                 **kwargs: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
+
+
+@overload
+def curvature_of(mesh_or_V: Any, F: ArrayLike | None = None, *, kind: Literal["directions"],
+                 per: Literal["vertex", "face"] = "vertex",
+                 **kwargs: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
+
+
+@overload
+def curvature_of(mesh_or_V: Any, F: ArrayLike | None = None, kind: str = "mean", per: str = "vertex",
+                 **kwargs: Any) -> NDArray[np.float64] | tuple[NDArray[np.float64], NDArray[np.float64]]: ...
+
+
+def curvature_of(mesh_or_V: Any, F: ArrayLike | None = None, kind: str = "mean", per: str = "vertex",
+                 **kwargs: Any) -> NDArray[np.float64] | tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """One curvature quantity of a mesh as plain arrays, in one call (in the spirit of
+    pyvista's ``mesh.curvature("mean")``).
+
+    Named ``curvature_of`` because ``igl_hhj.curvature`` is the module that holds the
+    curvature functions (this one included): a function of that name would shadow it.
+
+    Parameters
+    ----------
+    mesh_or_V : (#V, 3) array_like, or a mesh object with ``F`` omitted
+        Vertex positions, a :class:`igl_hhj.mesh.TriangleMesh`, or anything
+        :func:`igl_hhj.interop.mesh_arrays` accepts (``trimesh.Trimesh``,
+        triangulated ``pyvista.PolyData``, ``meshio.Mesh``).
+    F : (#F, 3) array_like int, optional
+        Triangles (required with arrays).
+    kind : {"mean", "gauss", "k1", "k2", "directions"}, default "mean"
+        Mean curvature H = (κ1 + κ2)/2, Gauss curvature K = κ1 κ2, the principal
+        curvatures κ1 ≥ κ2, or the principal directions.  ``"gaussian"``, ``"H"``
+        and ``"K"`` are accepted as aliases (:data:`CURVATURE_KIND_ALIASES`).
+    per : {"vertex", "face"}, default "vertex"
+        "vertex": from the drop-in :func:`principal_curvature` (recovered and
+        smoothed at ``radius``); "face": Walker's per-face S_h itself
+        (:func:`face_mean_curvature`, :func:`face_gaussian_curvature`,
+        :func:`face_principal_curvature`), the quantity with the convergence proof.
+    **kwargs
+        Passed on: ``radius``, ``useKring``, boundary data, ``solver``, ``rtol`` of
+        :func:`principal_curvature` (per vertex); boundary data, ``solver``,
+        ``smoothing`` of :func:`face_principal_curvature` (per face).
+
+    Returns
+    -------
+    values : (#V,) or (#F,) float64
+        For the scalar kinds.  Per vertex, the rows of the drop-in's
+        ``bad_vertices`` (unreferenced vertices, no tangent plane) are NaN.
+    (PD1, PD2) : tuple of two (#V, 3) or (#F, 3) float64
+        For ``"directions"``: unit directions of maximal / minimal curvature
+        (PD2 = N × PD1).
+
+    Raises
+    ------
+    ValueError
+        Unknown ``kind`` or ``per`` (the message lists the choices); and whatever
+        the underlying function raises for the mesh or the keyword arguments.
+
+    Examples
+    --------
+    >>> import igl_hhj
+    >>> from igl_hhj.surfaces import icosphere
+    >>> V, F = icosphere(3)
+    >>> H = igl_hhj.curvature_of(V, F)                        # per-vertex mean curvature
+    >>> K = igl_hhj.curvature_of(V, F, "gauss", per="face")   # Walker's S_h, per face
+    >>> H.shape, K.shape, round(float(H.mean()), 2)
+    ((642,), (1280,), 1.0)
+    >>> PD1, PD2 = igl_hhj.curvature_of(V, F, kind="directions")
+    """
+    kind = _curvature_kind(kind)
+    if per not in CURVATURE_PER:
+        raise ValueError(f"per must be one of {', '.join(map(repr, CURVATURE_PER))}, got {per!r}")
+    if per == "vertex":
+        PD1, PD2, PV1, PV2, _ = principal_curvature(mesh_or_V, F, **kwargs)
+    elif kind in ("mean", "gauss") and "smoothing" not in kwargs:
+        return (face_mean_curvature if kind == "mean" else face_gaussian_curvature)(mesh_or_V, F, **kwargs)
+    else:
+        PD1, PD2, PV1, PV2 = face_principal_curvature(mesh_or_V, F, **kwargs)
+    if kind == "directions":
+        return PD1, PD2
+    return {"k1": PV1, "k2": PV2, "mean": 0.5 * (PV1 + PV2), "gauss": PV1 * PV2}[kind]

@@ -17,7 +17,9 @@ from __future__ import annotations
 import functools
 import os
 import time
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from typing import Any, ParamSpec, TypeVar
 
 import numpy as np
 
@@ -27,7 +29,7 @@ import numpy as np
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 try:
-    from . import _hhj_core as _core
+    from . import _hhj_core
 except ImportError as exc:  # pragma: no cover - exercised only on a broken install
     raise ImportError(
         "igl_hhj's compiled core (igl_hhj._hhj_core) is missing or failed to load "
@@ -35,6 +37,7 @@ except ImportError as exc:  # pragma: no cover - exercised only on a broken inst
         "C++17 compiler and cmake, e.g. `pip install --force-reinstall --no-cache-dir .` "
         "from the igl_hhj source tree (scikit-build-core and nanobind come from PyPI)."
     ) from exc
+_core: Any = _hhj_core      # the extension has no stubs: its functions are typed here, by the wrappers
 
 __all__ = [
     "topology", "hhj_system", "jump_apply", "block_pcg", "shape_operator_faces",
@@ -133,7 +136,7 @@ def _user_malloc_policy():
 
 
 @contextmanager
-def large_call_heap(n_faces):
+def large_call_heap(n_faces: float) -> Iterator[bool]:
     """Open the large-call heap scope for a call on a mesh of ``n_faces`` faces.
 
     Yields True when the scope is active: the mesh's (#E, 3) float64 work arrays
@@ -161,13 +164,23 @@ def _n_faces_hint(V, F):
         return 0
 
 
-def with_large_call_heap(fn):
+_P = ParamSpec("_P")
+_R = TypeVar("_R")
+
+
+def with_large_call_heap(fn: Callable[_P, _R]) -> Callable[_P, _R]:
     """Decorator for public functions called as ``fn(V, F, ...)``: runs them inside
-    :func:`large_call_heap` (the signature is kept, ``inspect`` follows ``__wrapped__``)."""
+    :func:`large_call_heap`.
+
+    The signature is kept for static checkers (``Callable[P, R] -> Callable[P, R]``:
+    mypy and IDEs see the decorated function's own parameters and return type) and at
+    run time (``functools.wraps``; ``inspect`` follows ``__wrapped__``)."""
     @functools.wraps(fn)
-    def wrapper(V, F=None, *args, **kwargs):
+    def wrapper(*args: _P.args, **kwargs: _P.kwargs) -> _R:
+        V = args[0] if args else kwargs.get("V")
+        F = args[1] if len(args) > 1 else kwargs.get("F")
         with large_call_heap(_n_faces_hint(V, F)):
-            return fn(V, F, *args, **kwargs)
+            return fn(*args, **kwargs)
     return wrapper
 
 

@@ -44,10 +44,12 @@ Numerical-robustness policy (one set of limits for every solver)
 from __future__ import annotations
 
 from functools import cached_property
+from typing import Any
 
 import warnings
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 __all__ = ["TriangleMesh", "validate_mesh", "as_mesh", "mark_bad_vertices", "MeshWarning", "MeshDefectError",
            "DEGENERATE_AREA_RTOL", "COORDINATE_MAX", "MIN_MESH_SIZE", "topology_reference"]
@@ -544,7 +546,7 @@ class TriangleMesh:
                 stacklevel=3)
 
 
-def as_mesh(V, F=None):
+def as_mesh(V: Any, F: ArrayLike | None = None) -> TriangleMesh:
     """Return a :class:`TriangleMesh` for ``(V, F)``; a ``TriangleMesh`` passes through.
 
     With ``F`` None, ``V`` may also be a mesh object of another library
@@ -563,7 +565,7 @@ def as_mesh(V, F=None):
     return TriangleMesh(V, F)
 
 
-def validate_mesh(V, F):
+def validate_mesh(V: ArrayLike, F: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     """Validate ``(V, F)`` and return them as float64 / int64 C-contiguous (writable) copies.
 
     Raises the same errors as :class:`TriangleMesh`.

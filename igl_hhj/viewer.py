@@ -12,6 +12,9 @@ loads it.  Every ``register_*`` function
   Debian/Ubuntu install ``libegl1 libegl-mesa0 libgl1-mesa-dri``) only the
   structures of this call and write a PNG.
 
+In a notebook a :class:`Registration` shows itself as that picture (``_repr_png_``),
+and :func:`to_image` returns it as an (H, W, 4) uint8 array instead of a file.
+
 Interactive use::
 
     from igl_hhj import viewer
@@ -49,6 +52,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .mesh import as_mesh
 
@@ -57,7 +61,7 @@ __all__ = [
     "init", "show", "color_range", "curvature_estimate", "local_edge_length",
     "register_curvature", "register_comparison", "register_hessian", "register_biharmonic",
     "register_regge_curvature", "register_scalars", "merge", "screenshot",
-    "VIEWS", "best_view_direction", "view_rotation",
+    "VIEWS", "best_view_direction", "view_rotation", "to_image", "REPR_PNG_SIZE",
 ]
 
 QUANTITIES = ("k1", "k2", "H", "K")
@@ -132,6 +136,22 @@ class Registration:
     def names(self, structure):
         """Quantity names registered on ``structure``."""
         return [q for s, q in self.quantities if s == structure]
+
+    def _repr_png_(self) -> bytes | None:
+        """The headless picture of these structures (:func:`to_image`, :data:`REPR_PNG_SIZE`)
+        as PNG bytes: Jupyter / IPython show a registration as that image.
+
+        None (Jupyter then shows the text ``repr``) when nothing can be drawn:
+        polyscope not running, its mock backend, EGL missing, or the structures
+        removed since.  Like :func:`screenshot`, this moves polyscope's camera."""
+        import sys
+        ps = sys.modules.get("polyscope")
+        if not self.structures or ps is None or not ps.is_initialized() or _backend_name(ps) == "openGL_mock":
+            return None
+        try:
+            return _png_bytes(to_image(self, size=REPR_PNG_SIZE))
+        except (RuntimeError, ValueError):      # ViewerUnavailable is a RuntimeError
+            return None
 
     def __repr__(self):
         shown = [f"{s}: {q}" for (s, q), info in self.quantities.items() if info.enabled]
@@ -1024,20 +1044,27 @@ def _check_screenshot(path, size):
         raise ValueError(f"cannot write screenshot {path!r}: directory {folder!r} does not exist")
     if not os.access(folder, os.W_OK):
         raise ValueError(f"cannot write screenshot {path!r}: directory {folder!r} is not writable")
+    _check_size(size)
+    return path
+
+
+def _check_size(size):
+    """(width, height) of a picture, at least 16 x 16 pixels."""
     try:
         w, h = (int(x) for x in size)
     except (TypeError, ValueError):
         raise ValueError(f"size must be (width, height) in pixels, got {size!r}") from None
     if w < 16 or h < 16:
         raise ValueError(f"screenshot size must be at least 16 x 16 pixels, got {size!r}")
-    return path
+    return w, h
 
 
 def _render(reg, path, size, annotate=True):
     """Write a PNG of the structures of ``reg`` (others hidden during the shot), with
-    titles and colour bars composited on (``annotate``, needs matplotlib)."""
+    titles and colour bars composited on (``annotate``, needs matplotlib).  ``path``
+    None: return the picture, an (h, w, 4) uint8 RGBA array, instead."""
     path = _check_screenshot(path, size)
-    w, h = (int(x) for x in size)
+    w, h = _check_size(size)
     import polyscope as ps
     if not ps.is_initialized() or _backend_name(ps) == "openGL_mock":
         raise ViewerUnavailable("polyscope's mock backend draws nothing; register with screenshot=... "
@@ -1077,7 +1104,9 @@ def _render(reg, path, size, annotate=True):
             ps.reset_camera_to_home_view()
         if bars or titles:
             image = np.asarray(ps.screenshot_to_buffer(transparent_bg=False))
-            _compose(path, image, (w, h), bars, _title_positions(titles, camera, w, h_img), font)
+            picture = _compose(path, image, (w, h), bars, _title_positions(titles, camera, w, h_img), font)
+        elif path is None:
+            picture = np.array(ps.screenshot_to_buffer(transparent_bg=False), dtype=np.uint8)
         else:
             ps.screenshot(path, transparent_bg=False)
     finally:
@@ -1085,6 +1114,8 @@ def _render(reg, path, size, annotate=True):
             s.set_enabled(True)
         ps.set_automatically_compute_scene_extents(True)
         ps.set_view_projection_mode(projection)
+    if path is None:
+        return picture
     reg.screenshot = path
     return path
 
@@ -1146,7 +1177,8 @@ def _tick_text(x):
 
 def _compose(path, image, size, bars, titles, font):
     """Save ``image`` (polyscope's render, (h_img, w, 3|4) uint8) with ``titles``
-    (text, x, y) drawn on it and horizontal colour bars below, as a ``size`` PNG."""
+    (text, x, y) drawn on it and horizontal colour bars below, as a ``size`` PNG
+    (``path`` None: return the picture as an (h, w, 4) uint8 array)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.colorbar import ColorbarBase
     from matplotlib.colors import Normalize
@@ -1180,7 +1212,11 @@ def _compose(path, image, size, bars, titles, font):
             cax.tick_params(labelsize=0.9 * pt, length=2, pad=1)
             cb.outline.set_linewidth(0.5)
             cax.set_title(label, fontsize=pt, pad=0.6 * pt)
+    if path is None:
+        fig.canvas.draw()
+        return np.array(fig.canvas.buffer_rgba(), dtype=np.uint8)    # (h, w, 4): figsize × dpi
     fig.savefig(path, dpi=dpi, facecolor="white")
+    return None
 
 
 def _frame(ps, bounds, width, height, margin=0.04, top_px=0, left_px=0):
@@ -1241,11 +1277,67 @@ def screenshot(path, registration=None, *, size=(1024, 768), annotate=True) -> s
     ViewerUnavailable : no backend can render (e.g. EGL libraries missing).
     ValueError : unwritable path or bad size.
     """
+    return _render(_registration_of(registration), path, size, annotate)
+
+
+REPR_PNG_SIZE = (640, 480)
+"""(width, height) of the picture a :class:`Registration` shows in a notebook."""
+
+
+def to_image(registration: Any = None, *, size: tuple[int, int] = (1024, 768),
+             annotate: bool = True) -> NDArray[np.uint8]:
+    """The picture :func:`screenshot` would write, as an array instead of a PNG file.
+
+    Parameters
+    ----------
+    registration : Registration or list of them, optional
+        Only their structures are drawn (everything registered through this
+        module otherwise).
+    size : (width, height) in pixels of the whole picture.
+    annotate : bool, default True: titles and colour bars (see :func:`screenshot`).
+
+    Returns
+    -------
+    (H, W, 4) uint8 RGBA array, ``(W, H) = size``, opaque (alpha 255) on a white
+    background: ``matplotlib.pyplot.imshow`` it, or ``PIL.Image.fromarray``.
+
+    Raises
+    ------
+    ViewerUnavailable : no backend can render (polyscope's mock backend, EGL missing).
+    ValueError : bad size, or structures no longer registered.
+
+    Examples
+    --------
+    >>> from igl_hhj import viewer                                        # doctest: +SKIP
+    >>> reg = viewer.register_curvature(V, F, per="face")                 # doctest: +SKIP
+    >>> viewer.to_image(reg, size=(400, 300)).shape                       # doctest: +SKIP
+    (300, 400, 4)
+    >>> reg                     # in Jupyter: shown as the picture        # doctest: +SKIP
+    """
+    return _render(_registration_of(registration), None, size, annotate)
+
+
+def _registration_of(registration):
+    """The Registration to draw: everything of this module (None), a merge (list), or ``registration``."""
     if registration is None:
         import polyscope as ps
         names = [n for n in _REGISTERED if ps.has_surface_mesh(n)]
-        registration = Registration(structures={n: None for n in names},
-                                    bounds=_union_bounds(*(_REGISTERED[n] for n in names)))
-    elif isinstance(registration, (list, tuple)):
-        registration = merge(*registration)
-    return _render(registration, path, size, annotate)
+        return Registration(structures={n: None for n in names},
+                            bounds=_union_bounds(*(_REGISTERED[n] for n in names)))
+    if isinstance(registration, (list, tuple)):
+        return merge(*registration)
+    return registration
+
+
+def _png_bytes(image):
+    """PNG file bytes of an (h, w, 4) uint8 RGBA array (zlib only: no imaging library needed)."""
+    import struct
+    import zlib
+    image = np.ascontiguousarray(image, dtype=np.uint8)
+    h, w = image.shape[:2]
+    rows = np.concatenate([np.zeros((h, 1), dtype=np.uint8), image.reshape(h, w * 4)], axis=1)  # filter 0
+
+    def chunk(tag, data):
+        return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data) & 0xFFFFFFFF)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 6, 0, 0, 0))
+            + chunk(b"IDAT", zlib.compress(rows.tobytes(), 6)) + chunk(b"IEND", b""))

@@ -256,6 +256,66 @@ def test_render_refuses_removed_structures(egl, sphere, tmp_path):
     assert not (tmp_path / "g.png").exists()
 
 
+# --------------------------------------------------------------------------- pictures as arrays / notebooks
+def _decode_png(data):
+    import io
+
+    import matplotlib.image as mpimg
+    return np.round(mpimg.imread(io.BytesIO(data) if isinstance(data, bytes) else str(data)) * 255).astype(np.uint8)
+
+
+def test_png_bytes_round_trip():
+    rng = np.random.default_rng(1)
+    image = rng.integers(0, 256, size=(17, 23, 4), dtype=np.uint8)
+    data = viewer._png_bytes(image)
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    np.testing.assert_array_equal(_decode_png(data), image)
+
+
+def test_no_picture_without_a_renderer(mock, sphere):
+    """Under the mock backend a registration has no picture: Jupyter falls back to the text repr."""
+    V, F = sphere
+    reg = viewer.register_scalars(V, F, {"x": V[:, 0]}, name="m")
+    assert reg._repr_png_() is None
+    assert viewer.Registration()._repr_png_() is None
+    with pytest.raises(viewer.ViewerUnavailable, match="mock"):
+        viewer.to_image(reg)
+    with pytest.raises(ValueError, match="16 x 16"):
+        viewer.to_image(reg, size=(8, 8))
+
+
+def test_to_image_is_the_screenshot(egl, sphere, tmp_path):
+    """to_image returns exactly the picture screenshot writes: (H, W, 4) uint8, opaque;
+    with and without titles / colour bars; reg.screenshot is left alone."""
+    V, F = sphere
+    reg = viewer.register_curvature(V, F, name="s", per="face")
+    for annotate in (True, False):
+        im = viewer.to_image(reg, size=(320, 240), annotate=annotate)
+        assert im.shape == (240, 320, 4) and im.dtype == np.uint8 and (im[..., 3] == 255).all()
+        viewer.screenshot(tmp_path / f"s{annotate}.png", reg, size=(320, 240), annotate=annotate)
+        np.testing.assert_array_equal(im[..., :3], _decode_png(tmp_path / f"s{annotate}.png")[..., :3])
+    assert reg.screenshot == str(tmp_path / "sFalse.png")
+    viewer.to_image(reg, size=(64, 64))
+    assert reg.screenshot == str(tmp_path / "sFalse.png")
+    st = _check_png(tmp_path / "sTrue.png", (320, 240))
+    assert st["foreground"] > 0.1
+
+
+def test_registration_shows_as_png_in_notebooks(egl, sphere):
+    V, F = sphere
+    reg = viewer.register_curvature(V, F, name="nb", per="face")
+    data = reg._repr_png_()
+    assert data is not None and data[:8] == b"\x89PNG\r\n\x1a\n"
+    w, h = viewer.REPR_PNG_SIZE
+    np.testing.assert_array_equal(_decode_png(data), viewer.to_image(reg, size=(w, h)))
+    pytest.importorskip("IPython")
+    from IPython.core.formatters import DisplayFormatter
+    fmt, _ = DisplayFormatter().format(reg)
+    assert fmt["image/png"] == data and fmt["text/plain"].startswith("Registration(")
+    ps.remove_surface_mesh("nb")
+    assert reg._repr_png_() is None                   # removed structures: text repr only
+
+
 # --------------------------------------------------------------------------- headless renders (EGL)
 def _check_png(path, size, *, red=True, blue=False):
     st = png_stats(path)

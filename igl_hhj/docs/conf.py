@@ -9,3 +9,6 @@ autodoc_typehints = "description"
 autodoc_member_order = "bysource"
 html_theme = "alabaster"
 exclude_patterns = ["_build"]
+# the (string) annotations keep numpy's alias names: curvature_of's overloads are shown
+# as signatures, where the expanded ArrayLike union would fill several lines
+autodoc_type_aliases = {"ArrayLike": "numpy.typing.ArrayLike", "NDArray": "numpy.typing.NDArray"}

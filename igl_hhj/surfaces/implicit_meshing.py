@@ -97,14 +97,16 @@ def implicit_coarse(surface: ImplicitSurface, lo, hi, n_faces, *, grid=60, itera
     X = V0[F0]
     area = 0.5 * np.linalg.norm(np.cross(X[:, 1] - X[:, 0], X[:, 2] - X[:, 0]), axis=1).sum()
     h = np.sqrt(4.0 * area / (np.sqrt(3.0) * n_faces))          # equilateral triangles
-    best = None
-    for _ in range(tries):
+    best: tuple[np.ndarray, np.ndarray] | None = None
+    for _ in range(int(tries)):
         V, F = _remesh(V0, F0, h, iterations)
         if best is None or abs(len(F) - n_faces) < abs(len(best[1]) - n_faces):
             best = (V, F)
         if abs(len(F) - n_faces) <= 0.01 * n_faces:
             break
         h *= np.sqrt(len(F) / n_faces)
+    if best is None:
+        raise ValueError(f"tries must be at least 1, got {tries}")
     V, F = best
     V = surface.project(V)
     F = orient_outward(V, F, surface)
