@@ -39,9 +39,11 @@ def test_profile_stages_follows_the_default_drop_in():
     from igl_hhj.benchmarks.speed import profile_stages
     from igl_hhj.surfaces import icosphere
     out = profile_stages(*icosphere(3))
-    for key in ("validation + topology", "HHJ solve (auto)", "patch recovery",
-                "smoothing (4 Jacobi-CG solves)", "2x2 eigen"):
+    for key in ("validation + topology", "HHJ solve (auto)", "intrinsic patch recovery",
+                "smoothing (pilot + adaptive radius + twiced)", "principal values"):
         assert out[key] > 0
+        assert out["x above floor"][key] > 0           # seconds over the bandwidth floor of its arrays
+    assert out["bandwidth GB/s"] > 0 and 0 < out["floor of the stages"] < out["total of the stages"]
     assert out["large-call heap scope"] is False          # 1280 faces: below glibc's ceiling
     assert out["smoothing iterations"] > 0 and out["HHJ solver"] in ("direct", "cg")
     assert out["minor page faults"] == sum(out["page faults per stage"].values())

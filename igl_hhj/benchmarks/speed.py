@@ -374,55 +374,109 @@ def factor_markdown(rows):
     return "\n".join(lines)
 
 
-def profile_stages(V, F, rtol=None):
-    """Wall seconds (default threads) and minor page faults of the default drop-in's stages
-    on one mesh, in the drop-in's order: validation, estimated boundary normals (open
-    meshes), HHJ assembly, load, the ``auto`` solve (its iterations), S_h, vertex normals,
-    reliability weights, patch recovery, smoothing coefficients, the twiced smoothing (its
-    Jacobi-CG iterations over the four solves), 2×2 eigen.  A warm-up call runs first; the stages run inside
-    :func:`igl_hhj.kernels.large_call_heap`, as the drop-in does."""
+def copy_bandwidth(megabytes=256):
+    """This machine's memory bandwidth in bytes/s, measured now: the best of 3 copies of a
+    ``megabytes`` float64 array (bytes read + written / time)."""
+    a = np.ones(megabytes * (1 << 20) // 8)
+    b = np.empty_like(a)
+    best = np.inf
+    for _ in range(3):
+        t = time.perf_counter()
+        np.copyto(b, a)
+        best = min(best, time.perf_counter() - t)
+    return 2 * a.nbytes / best
+
+
+def _nbytes(*objs):
+    """Bytes of the numpy arrays among ``objs`` (nested in tuples/lists/dicts)."""
+    total = 0
+    for o in objs:
+        if isinstance(o, np.ndarray):
+            total += o.nbytes
+        elif isinstance(o, (tuple, list)):
+            total += _nbytes(*o)
+        elif isinstance(o, dict):
+            total += _nbytes(*o.values())
+    return total
+
+
+def profile_stages(V, F, rtol=None, radius=5):
+    """Wall seconds (default threads), minor page faults and distance from the memory
+    bandwidth floor of the default drop-in's stages on one mesh, in the drop-in's order:
+    validation + topology, estimated boundary normals (open meshes), HHJ assembly, load,
+    the ``auto`` solve (its iterations), S_h, vertex normals, reliability weights,
+    intrinsic patch recovery, smoothing coefficients, transport phases, the smoothing
+    (pilot step, adaptive radius, twiced smoothing: one compiled call, its Jacobi-CG
+    iterations), principal values (κ = H ± |z|).
+
+    ``floor[stage]``: the bytes of the stage's input and output arrays (each read or
+    written once: a lower bound of its memory traffic; iterative stages count one pass
+    per iteration) over :func:`copy_bandwidth` — ``seconds / floor`` is how far the stage
+    is above what streaming its data once would cost.  A warm-up call runs first; the
+    stages run inside :func:`igl_hhj.kernels.large_call_heap`, as the drop-in does."""
     import resource
 
-    from igl_hhj import kernels, principal_curvature, recovery, solvers
+    from igl_hhj import intrinsic, kernels, principal_curvature, recovery, solvers
     from igl_hhj.boundary_estimation import estimate_boundary_normals
     from igl_hhj.mesh import TriangleMesh
-    principal_curvature(V, F)                      # warm-up: imports, first-touch of the heap
-    out, faults = {}, {}
+    principal_curvature(V, F, radius)              # warm-up: imports, first-touch of the heap
+    bandwidth = copy_bandwidth()
+    out, faults, floor = {}, {}, {}
 
-    def stage(name, fn):
+    def stage(name, fn, inputs=(), passes=1):
         f0 = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
         t = time.perf_counter()
         r = fn()
         out[name] = time.perf_counter() - t
         faults[name] = resource.getrusage(resource.RUSAGE_SELF).ru_minflt - f0
+        floor[name] = _nbytes(inputs, r) * passes / bandwidth
         return r
+    rtol = rtol or solvers.DEFAULT_RTOL
+    Vf, Fi = np.ascontiguousarray(V, dtype=np.float64), np.ascontiguousarray(F, dtype=np.int64)
     # the public entry points run inside the large-call heap scope: so do the stages
     with kernels.large_call_heap(len(F)) as heap:
-        m = stage("validation + topology", lambda: (TriangleMesh(V, F), None)[0])
+        m = stage("validation + topology", lambda: TriangleMesh(Vf, Fi), (Vf, Fi))
+        topo = (m.edges, m.face_edges, m.edge_faces, m.edge_local_index)
+        floor["validation + topology"] += _nbytes(topo) / bandwidth
         if m.has_boundary:
-            stage("boundary normals (estimate)", lambda: estimate_boundary_normals(m))
-        system = stage("HHJ assembly + preconditioner", lambda: solvers.HHJSystem(m))
-        rhs = stage("load -B X", lambda: -kernels.jump_apply(m, m.V))
-        s, info = stage("HHJ solve (auto)", lambda: system.solve(rhs, "auto", rtol or solvers.DEFAULT_RTOL))
-        S = stage("S_h", lambda: kernels.shape_operator_faces(m, s))
-        N = stage("vertex normals", lambda: m.vertex_normals)
-        w = stage("reliability weights", lambda: kernels.recovery_weights(m, recovery.QUALITY_FLOOR))
-        X = stage("patch recovery", lambda: kernels.patch_recovery(m, S, N, w))
-        C, mass = stage("smoothing coefficients", lambda: recovery.smoothing_coefficients(m, w))
-        length = recovery.smoothing_length(m, 5)
-        status, its = stage("smoothing (4 Jacobi-CG solves)", lambda: kernels.smooth_vertex_tensors(
-            m, X, C, mass, length ** 2 / recovery.SMOOTHING_STEPS, recovery.SMOOTHING_STEPS,
-            recovery._kernel_coefficients(recovery.SMOOTHING_ORDER), 3e-3, 500))
-        kernels.tangent_projection6(m, X, N)
-        Sv = recovery._from6(X)
-        stage("2x2 eigen", lambda: kernels.principal_2x2(Sv, N))
+            stage("boundary normals (estimate)", lambda: estimate_boundary_normals(m), (Vf,))
+        system = stage("HHJ assembly + preconditioner", lambda: solvers.HHJSystem(m), (Vf, Fi, topo))
+        floor["HHJ assembly + preconditioner"] += _nbytes(system.A, system.M, system.cols) / bandwidth
+        rhs = stage("load -B X", lambda: -kernels.jump_apply(m, m.V), (Vf, Fi, topo))
+        s, info = stage("HHJ solve (auto)", lambda: system.solve(rhs, "auto", rtol), (rhs,))
+        # per PCG iteration: the matrix and the preconditioner rows, ~6 (#E, 3) vectors
+        floor["HHJ solve (auto)"] = max(1, info["iterations"]) * _nbytes(
+            system.A, system.M, system.cols, rhs, rhs, rhs, rhs, rhs, rhs) / bandwidth
+        S = stage("S_h", lambda: kernels.shape_operator_faces(m, s), (Vf, Fi, m.face_edges, s))
+        N = stage("vertex normals", lambda: m.vertex_normals, (Vf, Fi))
+        w = stage("reliability weights", lambda: kernels.recovery_weights(m, recovery.QUALITY_FLOOR),
+                  (Vf, Fi, m.face_edges, m.edge_faces))
+        X, rough = stage("intrinsic patch recovery", lambda: kernels.intrinsic_patch_recovery(m, S, N, w),
+                         (Vf, Fi, S, N, w))
+        C, mass = stage("smoothing coefficients", lambda: recovery.smoothing_coefficients(m, w), (Vf, Fi, w))
+        phase = stage("transport phases", lambda: kernels.transport_phases(m, N), (N, m.edges))
+        srtol = intrinsic.smoothing_rtol(rtol)
+        res = stage("smoothing (pilot + adaptive radius + twiced)", lambda: kernels.intrinsic_smoothing(
+            m, X, C, mass, phase, rough, radius, per_radius=recovery.SMOOTHING_PER_RADIUS,
+            pilot_radius=intrinsic.PILOT_RADIUS, pilot_rtol=srtol, gain=intrinsic.ADAPTIVE_GAIN,
+            power=intrinsic.ADAPTIVE_POWER, bounds=intrinsic.ADAPTIVE_RANGE, steps=intrinsic.SMOOTHING_STEPS,
+            coefficients=recovery._kernel_coefficients(intrinsic.SMOOTHING_ORDER), rtol=srtol, maxiter=500),
+            (Vf, Fi, C, mass, phase, rough, X))
+        its = res[1]
+        # per Jacobi-CG iteration: the Laplacian's edge weights and phases, ~6 (#V, 3) vectors
+        floor["smoothing (pilot + adaptive radius + twiced)"] = max(1, its) * _nbytes(
+            m.edges, phase, C, X, X, X, X, X, X) / bandwidth
+        stage("principal values", lambda: kernels.principal_hz(X, N), (X, N))
     out["total of the stages"] = sum(out.values())
+    out["floor of the stages"] = sum(floor.values())
+    out["bandwidth GB/s"] = bandwidth / 1e9
     out["large-call heap scope"] = heap
     out["HHJ solver"] = info["solver"]
     out["HHJ PCG iterations"] = info["iterations"]
     out["smoothing iterations"] = its
     out["minor page faults"] = sum(faults.values())
     out["page faults per stage"] = faults
+    out["x above floor"] = {k: out[k] / floor[k] for k in floor if floor[k] > 0}
     return out
 
 
@@ -521,6 +575,7 @@ def main(argv=None):
     p.add_argument("--profile", default=None, metavar="MESH",
                    help="only the wall time, iterations and page faults of each stage of the default "
                         "drop-in on one mesh, e.g. 'icosphere(8)'")
+    p.add_argument("--radius", type=int, default=5, help="--profile: the drop-in's radius")
     p.add_argument("--rtol-study", action="store_true",
                    help="only the tolerance study (PCG iterations and error vs rtol)")
     p.add_argument("--tiny", action="store_true",
@@ -541,8 +596,11 @@ def main(argv=None):
         return
     if a.profile:
         V, F = _build(a.profile, _default_mesh_dir() if a.meshes is None else Path(a.meshes))[0][1:]
-        for k, v in profile_stages(V, F).items():
-            print(f"{k}: {v:.3f}" if isinstance(v, float) else f"{k}: {v}")
+        prof = profile_stages(V, F, radius=a.radius)
+        above = prof.pop("x above floor")
+        for k, v in prof.items():
+            extra = f"   ({above[k]:.1f}x above floor)" if k in above else ""
+            print(f"{k}: {v:.4f}{extra}" if isinstance(v, float) else f"{k}: {v}")
         return
     if a.rtol_study:
         table = rtol_markdown(rtol_study())
