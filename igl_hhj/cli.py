@@ -144,9 +144,19 @@ def _viewer():
 
 
 def _quietly(fn, *args, **kwargs):
-    """Call ``fn`` with file descriptors 1/2 captured (polyscope's EGL start-up chatter)."""
-    with CapturedOutput():
-        return fn(*args, **kwargs)
+    """Call ``fn`` with file descriptors 1/2 captured (polyscope's EGL start-up chatter).
+
+    Python warnings raised meanwhile are held back and shown once the descriptors
+    are restored (they used to be written into the capture and lost).
+    """
+    caught: list = []
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            with CapturedOutput():
+                return fn(*args, **kwargs)
+    finally:
+        for w in caught:
+            warnings.showwarning(w.message, w.category, w.filename, w.lineno)
 
 
 # --------------------------------------------------------------------------- demo
@@ -214,7 +224,7 @@ def _demo_screenshot(V, F, surface, PV1, PV2, QV1, QV2, path, size=(1600, 700)):
     top = float(np.nanpercentile(np.concatenate(list(err.values())), 99))
     Vd = V @ viewer.view_rotation("auto", V, F, landscape=True).T   # the side with the largest projected area
     shift = np.array([1.1 * np.ptp(Vd[:, 0]), 0.0, 0.0])
-    regs = [_quietly(viewer.register_scalars, Vd, F, {"|H error| per vertex": e}, name=f"demo {k}",
+    regs = [_quietly(viewer.register_scalars, Vd, F, {f"|H error| per vertex [{viewer.LENGTH_UNIT}]": e}, name=f"demo {k}",
                      vminmax=(0.0, top), cmap="viridis", offset=i * shift,
                      title=f"{viewer.METHOD_TITLES[k]} — jittered ellipsoid, {len(F):,} faces")
             for i, (k, e) in enumerate(err.items())]

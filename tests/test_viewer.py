@@ -390,7 +390,7 @@ def test_titles_and_turned_copies(mock, ellipsoid):
     for key, q in plain.quantities.items():
         np.testing.assert_allclose(turned.quantities[key].values, q.values)
     # colour bars: one per (label, range, colour map) shown
-    assert viewer._colour_bars(plain) == [("mean curvature H", plain.ranges["H"], "coolwarm")]
+    assert viewer._colour_bars(plain) == [("mean curvature H [1/length unit]", plain.ranges["H"], "coolwarm")]
 
 
 def test_screenshot_has_a_colour_bar(egl, sphere, tmp_path):
