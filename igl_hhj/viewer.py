@@ -591,7 +591,7 @@ def _finish(reg, screenshot, size):
 
 # --------------------------------------------------------------------------- curvature
 def register_curvature(V: Any, F: Any = None, estimate=None, *, method="hhj", per="both", name="mesh", enabled="H",
-                       directions=True, show_directions=False, symmetric=True, robust=None, cmap="coolwarm", ranges=None,
+                       directions=True, show_directions=False, symmetric=True, robust=1.0, cmap="coolwarm", ranges=None,
                        direction_scale=0.5, offset=None, view=None, title=None, screenshot=None, size=(1024, 768),
                        **estimator_kwargs) -> Registration:
     """Register a mesh with its curvature: κ1, κ2, H, K (scalars) and principal directions.
@@ -611,7 +611,9 @@ def register_curvature(V: Any, F: Any = None, estimate=None, *, method="hhj", pe
     directions : bool, register the PD1/PD2 line fields.
     show_directions : bool, display them when the picture opens (screenshots).
     symmetric, robust : colour range (:func:`color_range`), shared by all
-        values of one quantity.
+        values of one quantity; default ``robust=1``: the 1st-99th percentiles, as
+        ``igl-hhj curvature --view`` (a few extreme values at sharp features or
+        defects would otherwise wash the picture out; None: the full range).
     cmap : polyscope colour map name (diverging by default).
     ranges : dict, optional, explicit ``{quantity: (lo, hi)}`` overriding the
         computed ranges (e.g. to match another picture).
@@ -692,7 +694,7 @@ def _check_sizes(mesh, ests):
 
 
 def register_comparison(V: Any, F: Any = None, *, hhj=None, libigl=None, per="face", layout="copy", name="mesh", enabled="H",
-                        directions=True, show_directions=False, symmetric=True, robust=None, cmap="coolwarm", offset=None,
+                        directions=True, show_directions=False, symmetric=True, robust=1.0, cmap="coolwarm", offset=None,
                         direction_scale=0.5, radius=5, view=None, title=None, screenshot=None, size=(1600, 800)) -> Registration:
     """HHJ curvature beside ``igl.principal_curvature`` on the same mesh, identical colour ranges.
 

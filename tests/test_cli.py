@@ -675,3 +675,22 @@ def test_huge_radius_is_a_usage_error(sphere, capsys, extra):
     path, _, _ = sphere
     assert cli.main(["curvature", str(path), "--radius", str(10**300)] + extra) == 2
     assert "--radius must be at most 1000000" in one_error_line(capsys.readouterr().err)
+
+
+def test_install_hints_work_from_a_checkout(capsys):
+    """Issue 26 (8): hints said ``pip install "igl-hhj[io]"``, which pip looks up on the
+    package index (no such release) instead of the checkout; they name ``.[extra]`` and
+    the package itself now, and a missing optional package is a user error (exit 2)."""
+    from pathlib import Path
+
+    from igl_hhj.errors import install_hint, missing_optional
+    assert install_hint("gpytoolbox") == 'pip install gpytoolbox (in a checkout of igl-hhj: pip install ".[demos]")'
+    assert install_hint("distributed").startswith('pip install "dask[distributed]"')
+    assert missing_optional(ModuleNotFoundError("x", name="triangle")) == "triangle"
+    assert missing_optional(ModuleNotFoundError("x", name="igl_hhj.nothing")) is None
+    code, message = cli._failure(ModuleNotFoundError("No module named 'meshio'", name="meshio"))
+    assert code == 2 and 'pip install ".[io]"' in message
+    assert cli._failure(ModuleNotFoundError("No module named 'igl_hhj.x'", name="igl_hhj.x"))[0] == 70
+    root = Path(cli.__file__).resolve().parent
+    stale = [str(p.relative_to(root)) for p in root.rglob("*.py") if "igl-hhj[" in p.read_text()]
+    assert stale == []
