@@ -64,6 +64,7 @@ import os
 import sys
 import threading
 import time
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -75,8 +76,8 @@ __all__ = ["compute_curvature", "check_curvature_options", "Job", "plan_jobs", "
            "run_batch", "BatchResult", "SUMMARY_COLUMNS", "FORMATS", "IN_PROCESS_MAX_FILES",
            "GROUP_BYTES"]
 
-FORMATS = ("npz", "ply", "vtu")
-"""Output formats of ``igl-hhj batch`` (``vtu`` needs meshio)."""
+FORMATS = ("npz", "ply", "vtp", "vtu")
+"""Output formats of ``igl-hhj batch`` (as ``igl-hhj curvature -o``)."""
 
 IN_PROCESS_MAX_FILES = 4
 """Without a scheduler, at most this many files run in-process (no cluster start-up)."""
@@ -92,12 +93,15 @@ GROUP_MAX = 16
 PERCENTILES = (1, 50, 99)
 QUANTITIES = ("k1", "k2", "H", "K")
 SUMMARY_COLUMNS = (["path", "output", "status", "vertices", "faces", "seconds", "cpu_seconds",
-                    "peak_memory", "error"]
+                    "peak_memory", "error", "warnings"]
                    + [f"{q}_p{p:02d}" for q in QUANTITIES for p in PERCENTILES] + ["nan_values"])
 """Columns of ``summary.csv``: ``seconds`` wall-clock and ``cpu_seconds`` CPU time (all
 threads of the process computing the mesh) from reading to writing; ``peak_memory`` in
 bytes (the process's peak resident set during the mesh, Linux only, empty when unknown
-or when the worker runs several threads); ``k1_p01 ... K_p99`` the 1st/50th/99th
+or when the worker runs several threads); ``warnings`` what the mesh's reading and
+computation warned about (libigl's reader messages, :class:`igl_hhj.mesh.MeshWarning`,
+numpy), one-line messages joined by `` | `` (empty: none), recorded where the mesh was
+computed, so Dask workers' warnings are not lost; ``k1_p01 ... K_p99`` the 1st/50th/99th
 percentiles over the vertices or faces; ``nan_values`` the number of elements without a
 value."""
 
@@ -197,39 +201,14 @@ def compute_curvature(V, F, *, method="hhj", per="vertex", radius=None, keep_sha
     return run(label, baselines.estimate, ESTIMATORS[method, per], V, F), None
 
 
-def _write_vtu(path, V, F, est, *, method, S=None):
-    """VTK unstructured grid via meshio: triangles, the curvature arrays as point or cell data."""
-    try:
-        import meshio
-    except ImportError:
-        raise MeshFileError("--format vtu needs meshio: pip install meshio") from None
-    n = len(est.k1)
-    data = {"k1": est.k1, "k2": est.k2, "H": est.H, "K": est.K,
-            "d1": est.d1 if est.d1 is not None else np.full((n, 3), np.nan),
-            "d2": est.d2 if est.d2 is not None else np.full((n, 3), np.nan)}
-    kw = ({"point_data": data} if est.location == "vertex"
-          else {"cell_data": {k: [v] for k, v in data.items()}})
-    if S is not None:
-        kw.setdefault("cell_data", {})["S"] = [S.reshape(len(F), 9)]
-    mesh = meshio.Mesh(V, [("triangle", np.asarray(F, dtype=np.int64))], **kw)
-    mesh.field_data = {}
-    meshio.write(str(path), mesh, file_format="vtu", binary=True)
-
-
-def _writer(fmt):
-    from . import mesh_io
-    if fmt == "vtu" and ".vtu" not in mesh_io.OUTPUT_EXTENSIONS:
-        return _write_vtu          # mesh_io has no vtu writer: ours, via meshio
-    return mesh_io.write_curvature
-
-
 def _atomic_write(path, fmt, V, F, est, method, S):
     """Write to ``.<name>.<pid>.<thread>.igl-hhj-tmp.<fmt>`` in the same folder, then rename."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.stem}.{os.getpid()}.{threading.get_ident()}{TMP_MARK}.{fmt}")
     try:
-        _writer(fmt)(tmp, V, F, est, method=method, S=S)
+        from .mesh_io import write_curvature
+        write_curvature(tmp, V, F, est, method=method, S=S)
         os.replace(tmp, path)
     finally:
         if tmp.exists():
@@ -355,15 +334,31 @@ def process_mesh(job, options, measure_peak=True):
     """Read, validate, compute and write one mesh; never raises for a bad mesh.
 
     Returns the summary row (dict with :data:`SUMMARY_COLUMNS`): status ``ok``
-    or ``error`` with the one-line message.
+    or ``error`` with the one-line message, and the warnings the mesh raised.
     """
-    from .mesh import TriangleMesh
-    from .mesh_io import read_mesh
     t0, c0 = time.perf_counter(), time.process_time()
     peak = measure_peak and _reset_peak_memory()
     extra = {}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")            # every mesh reports its own, not once per process
+        status, message, said = _compute_one(job, options, extra)
+    said += [str(w.message) for w in caught]
+    if said:
+        extra["warnings"] = " | ".join(dict.fromkeys(" ".join(m.split()) for m in said if m.strip()))
+    if peak:
+        extra["peak_memory"] = _proc_status_bytes("VmHWM")
+    return _row(job, status, seconds=round(time.perf_counter() - t0, 4),
+                cpu_seconds=round(time.process_time() - c0, 4), error=message, **extra)
+
+
+def _compute_one(job, options, extra):
+    """(status, error message, reader messages) of one mesh; statistics go into ``extra``."""
+    from .mesh import TriangleMesh
+    from .mesh_io import read_mesh
+    said = []
     try:
-        V, F, _ = read_mesh(job.path)
+        V, F, said = read_mesh(job.path)
+        said = list(said)
         extra.update(vertices=len(V), faces=len(F))
         try:
             mesh = TriangleMesh(V, F)
@@ -382,10 +377,7 @@ def process_mesh(job, options, measure_peak=True):
         if not isinstance(exc, (MeshFileError, ValueError, TypeError, OSError)):
             msg = f"{type(exc).__name__}: {msg}"
         status, message = "error", msg if msg.startswith(job.path) else f"{job.path}: {msg}"
-    if peak:
-        extra["peak_memory"] = _proc_status_bytes("VmHWM")
-    return _row(job, status, seconds=round(time.perf_counter() - t0, 4),
-                cpu_seconds=round(time.process_time() - c0, 4), error=message, **extra)
+    return status, message, said
 
 
 # --------------------------------------------------------------------------- sandbox
@@ -618,7 +610,8 @@ def _skipped_row(job, previous):
     row = _row(job, "skipped")
     if old is not None and old.get("status") in ("ok", "skipped") and old.get("faces"):
         for c in SUMMARY_COLUMNS[3:]:
-            if c not in ("seconds", "cpu_seconds", "peak_memory", "error") and old.get(c) not in (None, ""):
+            if c not in ("seconds", "cpu_seconds", "peak_memory", "error", "warnings") \
+                    and old.get(c) not in (None, ""):
                 row[c] = old[c]
     elif job.output.endswith(".npz"):    # finished by a worker after the interrupt reached us
         try:
@@ -679,7 +672,7 @@ def write_summary(rows, outdir):
         vals = [None if v in ("", None) else v for v in vals]
         if c in ("vertices", "faces", "peak_memory", "nan_values"):
             cols[c] = pa.array([None if v is None else int(v) for v in vals], pa.int64())
-        elif c in ("path", "output", "status", "error"):
+        elif c in ("path", "output", "status", "error", "warnings"):
             cols[c] = pa.array([None if v is None else str(v) for v in vals], pa.string())
         else:
             cols[c] = pa.array([None if v is None else float(v) for v in vals], pa.float64())
@@ -707,6 +700,8 @@ class _Progress:
     def update(self, row):
         self.done += 1
         self.failed += row["status"] in ("error", "timeout")
+        if row.get("warnings") and row["status"] != "skipped":   # also with -q: warnings are news
+            self._write(f"igl-hhj: warning: {row['path']}: {row['warnings']}")
         if not self.enabled:
             return
         if self.bar is not None:
@@ -719,6 +714,12 @@ class _Progress:
         if row.get("error"):
             line += f"  ({row['error']})"
         print(line, file=self.stream, flush=True)
+
+    def _write(self, line):
+        if self.bar is not None:
+            self.bar.write(line, file=self.stream)
+        else:
+            print(line, file=self.stream, flush=True)
 
     def close(self):
         if self.bar is not None:
@@ -845,9 +846,10 @@ def _import_distributed():
     try:
         import distributed  # noqa: F401
     except ImportError:
+        from .errors import install_hint
         raise ImportError("igl-hhj batch needs dask.distributed for more than "
                           f"{IN_PROCESS_MAX_FILES} files or a --scheduler: "
-                          "pip install 'igl-hhj[distributed]' (or --workers 0: in-process)") from None
+                          f"{install_hint('distributed')} (or --workers 0: in-process)") from None
 
 
 def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per="vertex",
@@ -869,7 +871,7 @@ def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per
         per task); 0: run in this process.  Ignored with ``scheduler``.
     method, per, radius
         As ``igl-hhj curvature`` (:func:`compute_curvature`).
-    fmt : {"npz", "ply", "vtu"}
+    fmt : {"npz", "ply", "vtp", "vtu"}
     resume : bool
         Skip inputs whose output is newer than the input (status ``skipped``).
     timeout : float, optional
@@ -893,11 +895,6 @@ def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per
         meshes finished so far; rerun to continue).
     """
     check_curvature_options(method, per, radius)
-    if fmt == "vtu":
-        try:
-            import meshio  # noqa: F401
-        except ImportError:
-            raise ValueError("--format vtu needs meshio: pip install meshio") from None
     if timeout is not None and not timeout > 0:
         raise ValueError(f"timeout must be positive, got {timeout}")
     if memory_limit is not None and not memory_limit > 0:

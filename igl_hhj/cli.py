@@ -8,8 +8,8 @@ Commands
     is missing).
 ``igl-hhj curvature MESH``
     principal curvatures and directions, mean and Gauss curvature of a mesh
-    file, written to ``.npz``, ``.csv`` or ``.ply``; optional polyscope view
-    or screenshot.
+    file, written to ``.npz``, ``.csv``, ``.ply``, ``.vtp``, ``.vtu``, ``.vtk`` or
+    ``.obj``; optional polyscope view or screenshot.
 ``igl-hhj info MESH``
     what the mesh is made of, whether igl_hhj accepts it, and which repairs the
     drop-in ``principal_curvature`` would make to a refused one.
@@ -144,9 +144,19 @@ def _viewer():
 
 
 def _quietly(fn, *args, **kwargs):
-    """Call ``fn`` with file descriptors 1/2 captured (polyscope's EGL start-up chatter)."""
-    with CapturedOutput():
-        return fn(*args, **kwargs)
+    """Call ``fn`` with file descriptors 1/2 captured (polyscope's EGL start-up chatter).
+
+    Python warnings raised meanwhile are held back and shown once the descriptors
+    are restored (they used to be written into the capture and lost).
+    """
+    caught: list = []
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            with CapturedOutput():
+                return fn(*args, **kwargs)
+    finally:
+        for w in caught:
+            warnings.showwarning(w.message, w.category, w.filename, w.lineno)
 
 
 # --------------------------------------------------------------------------- demo
@@ -214,7 +224,7 @@ def _demo_screenshot(V, F, surface, PV1, PV2, QV1, QV2, path, size=(1600, 700)):
     top = float(np.nanpercentile(np.concatenate(list(err.values())), 99))
     Vd = V @ viewer.view_rotation("auto", V, F, landscape=True).T   # the side with the largest projected area
     shift = np.array([1.1 * np.ptp(Vd[:, 0]), 0.0, 0.0])
-    regs = [_quietly(viewer.register_scalars, Vd, F, {"|H error| per vertex": e}, name=f"demo {k}",
+    regs = [_quietly(viewer.register_scalars, Vd, F, {f"|H error| per vertex [{viewer.LENGTH_UNIT}]": e}, name=f"demo {k}",
                      vminmax=(0.0, top), cmap="viridis", offset=i * shift,
                      title=f"{viewer.METHOD_TITLES[k]} — jittered ellipsoid, {len(F):,} faces")
             for i, (k, e) in enumerate(err.items())]
@@ -511,7 +521,8 @@ def build_parser():
                    help="output file, by extension: OUT.npz (k1, k2, H, K, d1, d2, V, F, and the "
                         "shape operator S for hhj), OUT.csv (one row per vertex or face), OUT.ply "
                         "(the values as vertex or face properties, --quantity as MeshLab's quality), "
-                        "OUT.vtu / OUT.vtk (point or cell data for ParaView/pyvista; needs meshio), "
+                        "OUT.vtp / OUT.vtu / OUT.vtk (point or cell data for ParaView/pyvista, "
+                        "--quantity the active scalars), "
                         "OUT.obj (vertices coloured by --quantity)")
     c.add_argument("--view", action="store_true", help="open the polyscope viewer")
     c.add_argument("--screenshot", metavar="PNG", help="render the curvature headless to PNG")
@@ -554,7 +565,7 @@ def build_parser():
                    help="as for 'igl-hhj curvature': hhj smoothing scale (default 5 per vertex, 0 per face), igl k-ring")
     b.add_argument("--format", choices=list(batch_formats()), default="npz",
                    help="npz (default; same content as 'igl-hhj curvature -o X.npz'), ply, or "
-                        "vtu (needs meshio)")
+                        "vtp / vtu (ParaView, pyvista)")
     b.add_argument("--resume", action=argparse.BooleanOptionalAction, default=True,
                    help="skip inputs whose output is newer than the input (default on)")
     b.add_argument("--timeout", type=float, metavar="S",
@@ -604,6 +615,10 @@ def _failure(exc):
         return EXIT_MEMORY, ("out of memory" + (f" ({_one_line(exc)})" if str(exc) else "")
                              + ": the computation needs more memory than this process may use; "
                                "try a smaller mesh or raise the memory limit")
+    from .errors import install_hint, missing_optional
+    package = missing_optional(exc)
+    if package is not None:
+        return EXIT_USAGE, f"this needs the optional '{package}' package: {install_hint(package)}"
     if isinstance(exc, (SolverError, np.linalg.LinAlgError)):
         return EXIT_SOLVER, (f"the solver failed: {_one_line(exc)} (check the mesh with "
                              f"'igl-hhj info'; rerun with --debug for the traceback)")

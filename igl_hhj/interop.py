@@ -184,26 +184,47 @@ def to_trimesh(V: Any, F: Any = None, results: Any = None) -> Any:
     return trimesh.Trimesh(V, F, process=False, vertex_attributes=pv_, face_attributes=pf)
 
 
-def to_pyvista(V: Any, F: Any = None, results: Any = None) -> Any:
-    """A ``pyvista.PolyData`` with the results as ``point_data`` / ``cell_data``."""
+def _rows(fields):
+    """{name: array} with tensors ``(n, 3, 3)`` (any ``ndim > 2``) as ``(n, 9)`` rows, the
+    layout VTK stores and ParaView shows as a tensor (row-major: ``S.reshape(-1, 3, 3)``
+    restores it)."""
+    return {k: (v.reshape(len(v), -1) if v.ndim > 2 else v) for k, v in fields.items()}
+
+
+def to_pyvista(V: Any, F: Any = None, results: Any = None, *, scalars: str | None = None) -> Any:
+    """A ``pyvista.PolyData`` with the results as ``point_data`` / ``cell_data``.
+
+    Tensors ``(n, 3, 3)`` become ``(n, 9)`` arrays.  ``scalars`` names the array
+    made active (what ``out.plot()`` shows); default ``"H"`` when the results have it.
+    """
     import pyvista
     V, F, results = _validated(V, F, results)
     out = pyvista.PolyData(V, np.column_stack([np.full(len(F), 3), F]).ravel())
     pv_, pf = result_fields(results, len(V), len(F))
-    for k, v in pv_.items():
+    for k, v in _rows(pv_).items():
         out.point_data[k] = v
-    for k, v in pf.items():
-        out.cell_data[k] = v.reshape(len(F), -1) if v.ndim > 2 else v
+    for k, v in _rows(pf).items():
+        out.cell_data[k] = v
+    active = scalars if scalars is not None else ("H" if "H" in pv_ or "H" in pf else None)
+    if active is not None:
+        if active not in pv_ and active not in pf:
+            raise ValueError(f"scalars={active!r} is not one of the results "
+                             f"({', '.join(list(pv_) + list(pf)) or 'none'})")
+        out.set_active_scalars(active, preference="point" if active in pv_ else "cell")
     return out
 
 
 def to_meshio(V: Any, F: Any = None, results: Any = None) -> Any:
     """A ``meshio.Mesh`` (one triangle block) with the results as ``point_data`` /
-    ``cell_data`` (``mesh.write("x.vtu")`` for ParaView)."""
+    ``cell_data`` (``mesh.write("x.vtu")`` for ParaView).
+
+    Tensors ``(n, 3, 3)`` become ``(n, 9)`` arrays (meshio writes a 3-d array into
+    ``.vtu`` with a wrong layout).  meshio marks no array as the active scalars; for
+    files ParaView opens coloured by H write them with
+    :func:`igl_hhj.vtk_files.write_vtk` (``.vtp`` / ``.vtu``, ``scalars="H"``).
+    """
     import meshio
     V, F, results = _validated(V, F, results)
     pv_, pf = result_fields(results, len(V), len(F))
-    # tensors as (n, 9) rows: meshio writes a (n, 3, 3) array into .vtu with a wrong layout
-    flat = {k: (v.reshape(len(v), -1) if v.ndim > 2 else v) for k, v in pv_.items()}
-    return meshio.Mesh(V, [("triangle", F)], point_data=flat,
-                       cell_data={k: [v.reshape(len(v), -1) if v.ndim > 2 else v] for k, v in pf.items()})
+    return meshio.Mesh(V, [("triangle", F)], point_data=_rows(pv_),
+                       cell_data={k: [v] for k, v in _rows(pf).items()})

@@ -33,9 +33,11 @@ problem.
 
 :func:`write_curvature` writes a
 :class:`igl_hhj.baselines.CurvatureEstimate` as ``.npz``, ``.csv``, ``.ply``
-(with MeshLab's ``quality``), ``.vtu`` / ``.vtk`` (through meshio, optional)
-or ``.obj`` with per-vertex colours, in forms that meshio, pyvista/VTK,
-pymeshlab/MeshLab and trimesh read (numpy only, no per-element Python loops).
+(with MeshLab's ``quality``), ``.vtp`` / ``.vtu`` / ``.vtk``
+(:mod:`igl_hhj.vtk_files`, the displayed quantity as the active scalars) or
+``.obj`` with per-vertex colours, in forms that meshio, pyvista/VTK/ParaView,
+pymeshlab/MeshLab, trimesh and Blender read (numpy only, no per-element Python
+loops, no optional dependency).
 """
 from __future__ import annotations
 
@@ -50,14 +52,18 @@ import numpy as np
 
 __all__ = ["MeshFileError", "CapturedOutput", "MESH_EXTENSIONS", "OUTPUT_EXTENSIONS", "read_mesh",
            "check_output_path", "probe_writable", "write_curvature", "CURVATURE_COLUMNS", "MESHIO_EXTENSIONS",
+           "VTK_EXTENSIONS",
            "quantity_colours"]
 
 MESH_EXTENSIONS = (".obj", ".off", ".ply", ".stl", ".wrl", ".mesh", ".msh")
 """Extensions ``igl.read_triangle_mesh`` dispatches on (case-insensitive)."""
 
-OUTPUT_EXTENSIONS = (".npz", ".csv", ".ply", ".vtu", ".vtk", ".obj")
-MESHIO_EXTENSIONS = (".vtu", ".vtk")
-"""Output extensions written through meshio (an optional dependency)."""
+OUTPUT_EXTENSIONS = (".npz", ".csv", ".ply", ".vtp", ".vtu", ".vtk", ".obj")
+VTK_EXTENSIONS = (".vtp", ".vtu", ".vtk")
+"""Output extensions written as VTK files (:mod:`igl_hhj.vtk_files`, numpy only)."""
+MESHIO_EXTENSIONS: tuple[str, ...] = ()
+"""Output extensions that need meshio: none any more (``.vtu`` / ``.vtk`` are written with
+numpy since issue 26); kept for scripts that check it."""
 
 CURVATURE_COLUMNS = ("k1", "k2", "H", "K", "d1x", "d1y", "d1z", "d2x", "d2y", "d2z")
 """Per-element columns of the ``.csv`` and ``.ply`` outputs (after ``index`` in the csv)."""
@@ -767,20 +773,8 @@ def check_output_path(path: str | os.PathLike) -> str:
     if ext not in OUTPUT_EXTENSIONS:
         raise MeshFileError(f"{path}: unknown output extension {path.suffix!r} "
                             f"(use {', '.join(OUTPUT_EXTENSIONS)})")
-    if ext in MESHIO_EXTENSIONS:
-        _meshio(path)
     probe_writable(path)
     return ext
-
-
-def _meshio(path):
-    """The meshio module, or a :class:`MeshFileError` saying how to install it."""
-    try:
-        import meshio
-    except ImportError:
-        raise MeshFileError(f"{path}: writing {Path(path).suffix} files needs meshio: "
-                            f"pip install meshio (or pip install \"igl-hhj[io]\")") from None
-    return meshio
 
 
 def probe_writable(path):
@@ -858,15 +852,18 @@ def _fields(est):
     return out
 
 
-def _write_meshio(path, V, F, est):
-    meshio = _meshio(path)
+def _write_vtk(path, V, F, est, S=None, quantity="H"):
+    """``.vtp`` / ``.vtu`` / ``.vtk``: the fields as point or cell data, ``quantity`` the
+    active scalars, the shape operator ``S`` (when given) as a 9-component cell tensor."""
+    from .vtk_files import write_vtk
     fields = _fields(est)
-    if est.location == "vertex":
-        mesh = meshio.Mesh(V, [("triangle", F)], point_data=fields)
-    else:
-        mesh = meshio.Mesh(V, [("triangle", F)], cell_data={k: [v] for k, v in fields.items()})
-    fmt = "vtk" if Path(path).suffix.lower() == ".vtk" else "vtu"
-    mesh.write(path, file_format=fmt, **({"binary": True} if fmt == "vtk" else {}))
+    fields = {quantity: fields.pop(quantity), **fields}          # the active scalars first
+    per_vertex = est.location == "vertex"
+    cells = {} if per_vertex else dict(fields)
+    if S is not None:
+        cells["S"] = np.asarray(S, dtype=np.float64)
+    write_vtk(path, V, F, point_data=fields if per_vertex else None, cell_data=cells, scalars=quantity,
+              title=f"igl_hhj curvature, method {est.name}, per {est.location}")
 
 
 _DIVERGING = np.array([[0.230, 0.299, 0.754], [0.865, 0.865, 0.865], [0.706, 0.016, 0.150]])
@@ -909,7 +906,8 @@ def _write_obj(path, V, F, est, quantity="H"):
 
 def write_curvature(path: str | os.PathLike, V: np.ndarray, F: np.ndarray, est: Any, *, method: str,
                     S: np.ndarray | None = None, quantity: str = "H") -> None:
-    """Write curvatures per face or per vertex to ``.npz``, ``.csv``, ``.ply``, ``.vtu``, ``.vtk`` or ``.obj``.
+    """Write curvatures per face or per vertex to ``.npz``, ``.csv``, ``.ply``, ``.vtp``, ``.vtu``, ``.vtk``
+    or ``.obj``.
 
     Parameters
     ----------
@@ -920,9 +918,11 @@ def write_curvature(path: str | os.PathLike, V: np.ndarray, F: np.ndarray, est: 
     method : str
         The method name stored in the file (``hhj``, ``igl``, ``heine``).
     S : (#F, 3, 3) float64, optional
-        The HHJ shape operator, stored in the ``.npz`` only.
+        The HHJ shape operator, stored in the ``.npz`` and (9-component cell
+        tensor ``S``) in the VTK files.
     quantity : {"k1", "k2", "H", "K"}
-        What the ``.ply`` ``quality`` property and the ``.obj`` colours hold.
+        What the ``.ply`` ``quality`` property and the ``.obj`` colours hold, and
+        the active scalars of the VTK files (what ParaView and pyvista show).
 
     Files
     -----
@@ -936,8 +936,11 @@ def write_curvature(path: str | os.PathLike, V: np.ndarray, F: np.ndarray, est: 
     colours by); binary little-endian.  Read by libigl, pymeshlab/MeshLab,
     trimesh; meshio 5.3 reads the per-vertex file but not binary face
     properties (write ``.vtu`` for meshio/pyvista per face).
-    ``.vtu`` / ``.vtk`` (needs meshio): k1, k2, H, K and the vectors d1, d2 as
-    point data (per vertex) or cell data (per face) — ParaView, pyvista.
+    ``.vtp`` (VTK XML PolyData: pyvista, ParaView), ``.vtu`` (XML
+    UnstructuredGrid: ParaView, pyvista, meshio), ``.vtk`` (legacy binary):
+    k1, k2, H, K and the vectors d1, d2 as point data (per vertex) or cell data
+    (per face), ``quantity`` the active scalars, d1 the active vectors
+    (:func:`igl_hhj.vtk_files.write_vtk`).
     ``.obj``: vertices coloured by ``quantity`` (``v x y z r g b``, a
     diverging map symmetric about 0 over the 1st-99th percentile magnitude;
     per-face values area-averaged to the vertices): a quick look, no values.
@@ -966,8 +969,8 @@ def write_curvature(path: str | os.PathLike, V: np.ndarray, F: np.ndarray, est: 
                    header=",".join(("index",) + CURVATURE_COLUMNS), comments="")
     elif ext == ".ply":
         _write_ply(path, V, F, est, quantity)
-    elif ext in MESHIO_EXTENSIONS:
-        _write_meshio(path, V, F, est)
+    elif ext in VTK_EXTENSIONS:
+        _write_vtk(path, V, F, est, S, quantity)
     elif ext == ".obj":
         _write_obj(path, V, F, est, quantity)
     else:

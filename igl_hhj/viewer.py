@@ -67,9 +67,11 @@ __all__ = [
 QUANTITIES = ("k1", "k2", "H", "K")
 METHODS = ("hhj", "igl", "heine")
 LABELS = {"k1": "kappa1", "k2": "kappa2", "H": "mean H", "K": "Gauss K"}
-LONG_LABELS = {"k1": "principal curvature κ1", "k2": "principal curvature κ2", "H": "mean curvature H",
-               "K": "Gauss curvature K"}
-"""Colour-bar labels of the curvature quantities."""
+LENGTH_UNIT = "1/length unit"
+"""Unit of curvatures in colour-bar labels (the mesh's coordinates carry the length unit)."""
+LONG_LABELS = {"k1": f"principal curvature κ1 [{LENGTH_UNIT}]", "k2": f"principal curvature κ2 [{LENGTH_UNIT}]",
+               "H": f"mean curvature H [{LENGTH_UNIT}]", "K": "Gauss curvature K [1/length unit²]"}
+"""Colour-bar labels of the curvature quantities (with their units)."""
 VIEWS = ("auto", "+x", "-x", "+y", "-y", "+z", "-z")
 """Named ``view=`` directions (the side the camera looks from); a 3-vector works too."""
 METHOD_TITLES = {"HHJ": "HHJ", "libigl": "libigl quadric fit", "Heine": "Heine P1"}
@@ -544,9 +546,16 @@ def _add_scalars(reg):
     items = sorted(((k, q) for k, q in reg.quantities.items() if q.kind == "scalar"),
                    key=lambda kq: kq[1].enabled)
     for (sname, qname), q in items:
-        reg.structures[sname].add_scalar_quantity(
-            qname, np.nan_to_num(q.values, nan=0.0, posinf=0.0, neginf=0.0), defined_on=q.defined_on,
-            vminmax=q.vminmax, cmap=q.cmap, enabled=q.enabled)
+        _add_scalar(reg, sname, qname, q)
+
+
+def _add_scalar(reg, sname, qname, q, colour_bar=False):
+    """Hand one recorded scalar quantity to polyscope (``colour_bar``: with polyscope's
+    own on-screen colour bar, drawn in screenshots that include the UI)."""
+    reg.structures[sname].add_scalar_quantity(
+        qname, np.nan_to_num(q.values, nan=0.0, posinf=0.0, neginf=0.0), defined_on=q.defined_on,
+        vminmax=q.vminmax, cmap=q.cmap, enabled=q.enabled,
+        **({"onscreen_colorbar_enabled": True} if colour_bar else {}))
 
 
 def _line_field(reg, sname, qname, vectors, normals, defined_on, enabled=False):
@@ -602,7 +611,7 @@ def _finish(reg, screenshot, size):
 
 # --------------------------------------------------------------------------- curvature
 def register_curvature(V: Any, F: Any = None, estimate=None, *, method="hhj", per="both", name="mesh", enabled="H",
-                       directions=True, show_directions=False, symmetric=True, robust=None, cmap="coolwarm", ranges=None,
+                       directions=True, show_directions=False, symmetric=True, robust=1.0, cmap="coolwarm", ranges=None,
                        direction_scale=0.5, offset=None, view=None, title=None, screenshot=None, size=(1024, 768),
                        **estimator_kwargs) -> Registration:
     """Register a mesh with its curvature: κ1, κ2, H, K (scalars) and principal directions.
@@ -622,7 +631,9 @@ def register_curvature(V: Any, F: Any = None, estimate=None, *, method="hhj", pe
     directions : bool, register the PD1/PD2 line fields.
     show_directions : bool, display them when the picture opens (screenshots).
     symmetric, robust : colour range (:func:`color_range`), shared by all
-        values of one quantity.
+        values of one quantity; default ``robust=1``: the 1st-99th percentiles, as
+        ``igl-hhj curvature --view`` (a few extreme values at sharp features or
+        defects would otherwise wash the picture out; None: the full range).
     cmap : polyscope colour map name (diverging by default).
     ranges : dict, optional, explicit ``{quantity: (lo, hi)}`` overriding the
         computed ranges (e.g. to match another picture).
@@ -703,7 +714,7 @@ def _check_sizes(mesh, ests):
 
 
 def register_comparison(V: Any, F: Any = None, *, hhj=None, libigl=None, per="face", layout="copy", name="mesh", enabled="H",
-                        directions=True, show_directions=False, symmetric=True, robust=None, cmap="coolwarm", offset=None,
+                        directions=True, show_directions=False, symmetric=True, robust=1.0, cmap="coolwarm", offset=None,
                         direction_scale=0.5, radius=5, view=None, title=None, screenshot=None, size=(1600, 800)) -> Registration:
     """HHJ curvature beside ``igl.principal_curvature`` on the same mesh, identical colour ranges.
 
@@ -962,7 +973,7 @@ def register_regge_curvature(V: Any, F: Any = None, *, boundary="natural", mass=
     _surface(ps, reg, name, mesh.V, mesh.F, offset, view, _title(title, what, name, mesh))
     for key, (qname, vals, where) in fields.items():
         _scalar(reg, name, qname, vals, where, reg.ranges["K"], cmap, enabled=(key == enabled),
-                label="Gauss curvature K")
+                label=LONG_LABELS["K"])
     return _finish(reg, screenshot, size)
 
 
@@ -1071,11 +1082,13 @@ def _render(reg, path, size, annotate=True):
                                 "(which starts the EGL backend) or call viewer.init('openGL3_egl') first")
     bars = _colour_bars(reg) if annotate else []
     titles = {n: t for n, t in reg.titles.items() if t and n in reg.structures} if annotate else {}
-    if (bars or titles) and not _have_matplotlib():
+    with_matplotlib = _have_matplotlib()
+    own_bars = []                     # drawn by polyscope itself when matplotlib is missing
+    if (bars or titles) and not with_matplotlib:
         import warnings
-        warnings.warn("matplotlib is not installed: screenshot written without titles and colour bars",
-                      stacklevel=3)
-        bars, titles = [], {}
+        warnings.warn("matplotlib is not installed: screenshot written with polyscope's colour bar but "
+                      "without titles (pip install matplotlib)", stacklevel=3)
+        own_bars, bars, titles = _bar_quantities(reg), [], {}
     font = _font_px(w, h)
     bar_px = int(round(3.8 * font)) if bars else 0
     top_px = int(round(1.7 * font)) if titles else 0
@@ -1107,8 +1120,10 @@ def _render(reg, path, size, annotate=True):
             picture = _compose(path, image, (w, h), bars, _title_positions(titles, camera, w, h_img), font)
         elif path is None:
             picture = np.array(ps.screenshot_to_buffer(transparent_bg=False), dtype=np.uint8)
+        elif own_bars:
+            _polyscope_screenshot_with_bars(ps, reg, own_bars, path)
         else:
-            ps.screenshot(path, transparent_bg=False)
+            _write_screenshot(ps, path)
     finally:
         for s in hidden:
             s.set_enabled(True)
@@ -1118,6 +1133,71 @@ def _render(reg, path, size, annotate=True):
         return picture
     reg.screenshot = path
     return path
+
+
+def _bar_quantities(reg):
+    """[(structure, quantity)]: the first shown scalar quantity of each distinct colour bar."""
+    seen, out = set(), []
+    for (sname, qname), q in reg.quantities.items():
+        if q.kind == "scalar" and q.enabled and sname in reg.structures:
+            key = (q.label or qname, tuple(q.vminmax), q.cmap or "viridis")
+            if key not in seen:
+                seen.add(key)
+                out.append((sname, qname))
+    return out
+
+
+def _polyscope_screenshot_with_bars(ps, reg, quantities, path):
+    """Screenshot with polyscope's own on-screen colour bars of ``quantities`` (the UI
+    is included but its panels are not built), plain quantities again afterwards."""
+    for sname, qname in quantities:
+        _add_scalar(reg, sname, qname, reg.quantities[(sname, qname)], colour_bar=True)
+    ps.set_build_gui(False)
+    try:
+        _write_screenshot(ps, path, include_UI=True)
+    finally:
+        ps.set_build_gui(True)
+        for sname, qname in quantities:
+            _add_scalar(reg, sname, qname, reg.quantities[(sname, qname)])
+
+
+def _write_screenshot(ps, path, include_UI=False):
+    """polyscope's render as a palette PNG (:func:`_save_png`), or as polyscope writes it
+    when Pillow is missing."""
+    image = np.asarray(ps.screenshot_to_buffer(transparent_bg=False, include_UI=include_UI))
+    if not _save_png(path, image):
+        ps.screenshot(path, transparent_bg=False, include_UI=include_UI)
+
+
+PNG_COLOURS = 256
+"""Screenshots are written as palette PNGs of at most this many colours (with Pillow)."""
+
+
+def _save_png(path, image, keep=None):
+    """Write an (h, w, 3|4) uint8 image as a palette PNG of at most :data:`PNG_COLOURS`
+    colours (several times smaller than full RGB, the picture unchanged to the eye).
+
+    The palette is a median cut of the image plus the colours ``keep`` ((k, 3) uint8,
+    e.g. samples of the colour bars' maps, so that a bar stays a smooth ramp); every
+    pixel gets its nearest palette colour (no dithering: smooth shading compresses
+    well and shows no noise).  Returns False (nothing written) when Pillow is missing.
+    """
+    try:
+        from PIL import Image
+    except ImportError:
+        return False
+    img = Image.fromarray(np.ascontiguousarray(np.asarray(image, dtype=np.uint8)[..., :3]), "RGB")
+    keep = np.zeros((0, 3), np.uint8) if keep is None else np.asarray(keep, dtype=np.uint8).reshape(-1, 3)
+    keep = np.unique(keep, axis=0)[: PNG_COLOURS // 2]
+    cut = img.quantize(colors=PNG_COLOURS - len(keep), method=0)            # 0: median cut
+    flat = np.asarray(cut.getpalette() or [], dtype=np.uint8)
+    found = flat[: len(flat) // 3 * 3].reshape(-1, 3)
+    used = np.unique(np.asarray(cut)).astype(np.int64)
+    colours = np.concatenate([found[used[used < len(found)]], keep])
+    palette = Image.new("P", (1, 1))
+    palette.putpalette(colours.ravel().tolist() + colours[:1].ravel().tolist() * (256 - len(colours)))
+    img.quantize(palette=palette, dither=0).save(os.fspath(path), format="PNG", optimize=True)
+    return True
 
 
 def _have_matplotlib():
@@ -1212,10 +1292,14 @@ def _compose(path, image, size, bars, titles, font):
             cax.tick_params(labelsize=0.9 * pt, length=2, pad=1)
             cb.outline.set_linewidth(0.5)
             cax.set_title(label, fontsize=pt, pad=0.6 * pt)
+    canvas = fig.canvas
+    canvas.draw()
     if path is None:
-        fig.canvas.draw()
-        return np.array(fig.canvas.buffer_rgba(), dtype=np.uint8)    # (h, w, 4): figsize × dpi
-    fig.savefig(path, dpi=dpi, facecolor="white")
+        return np.array(canvas.buffer_rgba(), dtype=np.uint8)    # (h, w, 4): figsize × dpi
+    ramps = [_mpl_cmap(cmap)(np.linspace(0.0, 1.0, 48))[:, :3] for _, _, cmap in bars]
+    keep = np.round(255 * np.concatenate(ramps)) if ramps else None
+    if not _save_png(path, np.asarray(canvas.buffer_rgba()), keep):
+        fig.savefig(path, dpi=dpi, facecolor="white")
     return None
 
 

@@ -171,6 +171,20 @@ def require_egl():
     pytest.skip(f"no EGL for headless rendering: {msg}")
 
 
+def require_test_extra(name):
+    """Import ``name``, a package of the ``[test]`` extra (e.g. pyvista): skip when it is
+    missing and $CI is unset; in CI (which installs the extra) a missing one is a failure,
+    so the round trips it checks cannot pass by being skipped."""
+    import importlib
+    import os
+    try:
+        return importlib.import_module(name)
+    except ImportError as exc:
+        if os.environ.get("CI"):
+            pytest.fail(f"CI is set but {name} (in the [test] extra) cannot be imported: {exc}")
+        pytest.skip(f"{name} is not installed (pip install \".[test]\")")
+
+
 def png_stats(path):
     """(height, width, std of RGB, fraction of non-white pixels, fraction of reddish,
     fraction of bluish pixels) of a PNG screenshot."""

@@ -17,6 +17,7 @@ from pathlib import Path
 import igl
 import numpy as np
 import pytest
+from conftest import require_test_extra
 
 from igl_hhj import baselines, batch, cli
 
@@ -173,9 +174,13 @@ def test_user_errors(collection, tmp_path, capsys, monkeypatch):
     assert [cli._memory_bytes(t) for t in ("4G", "512MiB", "2e9", "1500k")] == \
         [4_000_000_000, 512 * 2**20, 2_000_000_000, 1_500_000]
     with monkeypatch.context() as m:
-        m.setitem(sys.modules, "meshio", None)           # meshio not installed
-        assert cli.main(["batch", str(good[0]), "-o", str(tmp_path / "x"), "--format", "vtu"]) == 2
-        assert "--format vtu needs meshio: pip install meshio" in capsys.readouterr().err
+        m.setitem(sys.modules, "meshio", None)           # meshio not installed: vtu / vtp still work
+        for fmt in ("vtu", "vtp"):
+            assert cli.main(["batch", str(good[0]), "-o", str(tmp_path / fmt), "--format", fmt, "-q"]) == 0
+            capsys.readouterr()
+    pv = require_test_extra("pyvista")
+    grid = pv.read(next((tmp_path / "vtp").rglob("*.vtp")))
+    assert type(grid).__name__ == "PolyData" and grid.point_data.active_scalars_name == "H"
     for argv, fragment in [(["--method", "igl", "--per", "face"], "per-vertex curvature only"),
                            (["--method", "heine", "--radius", "2"], "--radius applies"),
                            (["--memory-limit", "lots"], "not a positive number of bytes"),
@@ -533,3 +538,36 @@ def test_pending_options_entry_dates_the_output(tmp_path):
     assert batch._made_with({"options": key, "done": False, "t": mtime + 1}, str(out)) is None
     assert batch._made_with({"options": key, "done": True, "t": mtime + 1}, str(out)) == key
     assert batch._made_with(None, str(out)) is None and batch._made_with("junk", str(out)) is None
+
+
+# --------------------------------------------------------------------------- warnings (issue 26)
+def _unwelded(path):
+    """Two halves of a wavy sheet with their seam vertices duplicated: a MeshWarning."""
+    def half(x0):
+        xs, ys = np.meshgrid(np.linspace(x0, x0 + 0.5, 5), np.linspace(0, 1, 9))
+        V = np.column_stack([xs.ravel(), ys.ravel(), 0.1 * np.sin(3 * xs.ravel()) * ys.ravel()])
+        a = (np.arange(8)[:, None] * 5 + np.arange(4)).ravel()
+        return V, np.concatenate([np.column_stack([a, a + 1, a + 6]), np.column_stack([a, a + 6, a + 5])])
+    (V1, F1), (V2, F2) = half(0.0), half(0.5)
+    igl.write_triangle_mesh(str(path), np.vstack([V1, V2]), np.vstack([F1, F2 + len(V1)]))
+    return path
+
+
+@pytest.mark.parametrize("workers", ["0", "1"])
+def test_warnings_reach_the_summary_and_stderr(collection, tmp_path, capsys, workers):
+    """On Dask the workers' warnings used to be lost: each row has a ``warnings``
+    column, and the warning is printed with the file's name (in-process: it used to be
+    printed without it)."""
+    _, good, _ = collection
+    bad = _unwelded(tmp_path / "unwelded.off")
+    out = tmp_path / "out"
+    assert cli.main(["batch", str(bad), str(good[0]), "-o", str(out), "--workers", workers, "-q"]) == 0
+    cap = capsys.readouterr()
+    rows = read_summary(out)
+    assert "coincide with other vertices" in rows[str(bad)]["warnings"]
+    assert rows[str(good[0])]["warnings"] == ""
+    lines = [ln for ln in cap.err.splitlines() if "warning" in ln]
+    assert len(lines) == 1 and lines[0].startswith(f"igl-hhj: warning: {bad}: ") and "coincide" in lines[0], cap.err
+    # a resumed run skips the mesh: no warning printed again
+    assert cli.main(["batch", str(bad), str(good[0]), "-o", str(out), "--workers", workers, "-q"]) == 0
+    assert "warning" not in capsys.readouterr().err

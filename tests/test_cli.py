@@ -300,6 +300,52 @@ def test_curvature_screenshot(sphere, tmp_path, capsys):
     assert code == 0 and png.stat().st_size > 0 and str(png) in cap.out
 
 
+def test_screenshots_are_annotated_palette_pngs(sphere, tmp_path, monkeypatch, capsys):
+    """Issue 26 (1): ``igl-hhj demo`` and ``curvature --screenshot`` write the annotated
+    picture (title at the top, colour bar with range and unit below) as a palette PNG of
+    at most 256 colours."""
+    from PIL import Image
+    monkeypatch.chdir(tmp_path)
+    path, _, _ = sphere
+    code, _ = render_or_skip(["curvature", str(path), "--screenshot", "c.png", "--size", "400", "300"], capsys)
+    assert code == 0
+    code, _ = render_or_skip(["demo", "--levels", "2", "--size", "600", "300"], capsys)
+    assert code == 0
+    for png in ("c.png", "igl_hhj_demo.png"):
+        im = Image.open(png)
+        assert im.mode == "P" and len(im.getcolors(256) or ()) <= 256, png
+        rgb = np.asarray(im.convert("RGB"), dtype=float) / 255
+        text = (rgb.max(axis=2) < 0.35) & (np.ptp(rgb, axis=2) < 0.05)     # dark grey: text, not the mesh
+        h = len(rgb)
+        assert text[: h // 4].any(), png           # the title at the top
+        assert text[-h // 8:].any(), png           # the colour bar's tick labels at the bottom
+    from igl_hhj import viewer
+    assert viewer.LONG_LABELS["H"].endswith(f"[{viewer.LENGTH_UNIT}]")
+
+
+def test_screenshot_without_matplotlib_warns_and_keeps_a_colour_bar(sphere, tmp_path, monkeypatch, capsys):
+    """The annotation warning used to be written into the captured EGL chatter and lost;
+    now it is one ``igl-hhj: warning:`` line, and polyscope draws its own colour bar."""
+    import warnings
+    monkeypatch.setitem(sys.modules, "matplotlib", None)
+    path, _, _ = sphere
+    png = tmp_path / "plain.png"
+    code, cap = render_or_skip(["curvature", str(path), "--screenshot", str(png),
+                                "--size", "400", "300"], capsys)
+    assert code == 0 and png.stat().st_size > 0, cap.err
+    assert "igl-hhj: warning: matplotlib is not installed" in cap.err and "pip install matplotlib" in cap.err
+    monkeypatch.delitem(sys.modules, "matplotlib")
+    from PIL import Image
+    rgb = np.asarray(Image.open(png).convert("RGB"), dtype=int)
+    # the unit sphere is red everywhere (H = 1 > 0): blue pixels come from polyscope's coolwarm bar
+    assert ((rgb[..., 2] - rgb[..., 0]) > 60).sum() > 100
+    # a warning inside any captured call is shown afterwards, not lost
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        with pytest.warns(UserWarning, match="held back"):
+            assert cli._quietly(lambda: warnings.warn("held back") or 7) == 7
+
+
 def test_curvature_view_registers_the_estimate(sphere, monkeypatch, capsys):
     from igl_hhj import viewer
     calls = []
@@ -629,3 +675,22 @@ def test_huge_radius_is_a_usage_error(sphere, capsys, extra):
     path, _, _ = sphere
     assert cli.main(["curvature", str(path), "--radius", str(10**300)] + extra) == 2
     assert "--radius must be at most 1000000" in one_error_line(capsys.readouterr().err)
+
+
+def test_install_hints_work_from_a_checkout(capsys):
+    """Issue 26 (8): hints said ``pip install "igl-hhj[io]"``, which pip looks up on the
+    package index (no such release) instead of the checkout; they name ``.[extra]`` and
+    the package itself now, and a missing optional package is a user error (exit 2)."""
+    from pathlib import Path
+
+    from igl_hhj.errors import install_hint, missing_optional
+    assert install_hint("gpytoolbox") == 'pip install gpytoolbox (in a checkout of igl-hhj: pip install ".[demos]")'
+    assert install_hint("distributed").startswith('pip install "dask[distributed]"')
+    assert missing_optional(ModuleNotFoundError("x", name="triangle")) == "triangle"
+    assert missing_optional(ModuleNotFoundError("x", name="igl_hhj.nothing")) is None
+    code, message = cli._failure(ModuleNotFoundError("No module named 'meshio'", name="meshio"))
+    assert code == 2 and 'pip install ".[io]"' in message
+    assert cli._failure(ModuleNotFoundError("No module named 'igl_hhj.x'", name="igl_hhj.x"))[0] == 70
+    root = Path(cli.__file__).resolve().parent
+    stale = [str(p.relative_to(root)) for p in root.rglob("*.py") if "igl-hhj[" in p.read_text()]
+    assert stale == []

@@ -202,3 +202,33 @@ def test_interactive_without_display_is_a_one_line_error(requires_egl):
     assert res.returncode == 1, res.stderr
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and "--screenshot" in lines[0], res.stderr
+
+
+# --------------------------------------------------------------------------- first ten minutes (issue 26)
+def test_missing_demo_package_is_a_clear_error_not_an_internal_one(capsys, monkeypatch):
+    """``igl-hhj demo curved`` on a plain install (no gpytoolbox) used to end in
+    'internal error: ModuleNotFoundError' (exit 70): now one line naming the package
+    and commands that work from a checkout, exit 2."""
+    from igl_hhj import cli
+    monkeypatch.setitem(sys.modules, "gpytoolbox", None)           # import gpytoolbox -> ModuleNotFoundError
+    assert cli.main(["demo", "curved", "--screenshot", "x.png"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("igl-hhj demo curved: error: "), err
+    assert "'gpytoolbox'" in err[0] and "pip install gpytoolbox" in err[0] and 'pip install ".[demos]"' in err[0]
+    assert "internal error" not in err[0] and "igl-hhj[" not in err[0]
+    # the same from the script in demos/
+    res = run(["-c", "import sys; sys.modules['gpytoolbox'] = None; sys.argv = ['curved.py']; "
+                     "import runpy; runpy.run_path('demos/curved.py', run_name='__main__')"], timeout=60)
+    assert res.returncode == 2 and 'pip install ".[demos]"' in res.stderr, res.stderr
+
+
+def test_quickstart_creates_its_out_dir(tmp_path):
+    """--out-dir used to have to exist ('no such directory'); it is created now."""
+    out = tmp_path / "new" / "results"
+    res = run(["demos/quickstart.py", "--out-dir", str(out), "--no-screenshot"], timeout=120)
+    assert res.returncode == 0, res.stderr
+    assert {p.name for p in out.iterdir()} >= {"torus.off", "torus_curvature.ply", "torus_curvature.vtp",
+                                                "torus_curvature.npz"}
+    (tmp_path / "file").write_text("x")
+    res = run(["demos/quickstart.py", "--out-dir", str(tmp_path / "file"), "--no-screenshot"], timeout=60)
+    assert res.returncode == 2 and "is a file, not a folder" in res.stderr

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import require_test_extra
 
 import igl_hhj
 from igl_hhj import baselines, interop
@@ -27,12 +28,8 @@ def _objects(V, F):
     out["trimesh"] = trimesh.Trimesh(V, F, process=False)
     meshio = pytest.importorskip("meshio")
     out["meshio"] = meshio.Mesh(V, [("vertex", np.arange(3)[:, None]), ("triangle", F)])
-    try:
-        import pyvista
-    except ImportError:
-        pass
-    else:
-        out["pyvista"] = pyvista.PolyData(V, np.column_stack([np.full(len(F), 3), F]).ravel())
+    pyvista = require_test_extra("pyvista")
+    out["pyvista"] = pyvista.PolyData(V, np.column_stack([np.full(len(F), 3), F]).ravel())
     return out
 
 
@@ -75,7 +72,7 @@ def test_bad_objects_are_clear_errors(mesh):
 
 
 def test_pyvista_needs_triangles(mesh):
-    pv = pytest.importorskip("pyvista")
+    pv = require_test_extra("pyvista")
     quad = pv.PolyData(np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.0]]), np.array([4, 0, 1, 2, 3]))
     with pytest.raises(ValueError, match="triangulate"):
         igl_hhj.shape_operator(quad)
@@ -105,7 +102,7 @@ def test_results_back_onto_objects(mesh):
 
 
 def test_results_onto_pyvista(mesh):
-    pytest.importorskip("pyvista")
+    require_test_extra("pyvista")
     V, F = mesh
     est = baselines.hhj_vertex(V, F)
     p = interop.to_pyvista(V, F, est)
@@ -137,6 +134,31 @@ def test_tensors_round_trip_through_vtu(mesh, tmp_path):
     back = meshio.read(tmp_path / "s.vtu")
     np.testing.assert_allclose(back.cell_data["S"][0].reshape(-1, 3, 3), S)
     np.testing.assert_allclose(back.point_data["Sv"].reshape(-1, 3, 3), Sv)
+    # VTK itself (pyvista's reader) sees valid 9-component arrays of the right length
+    pv = require_test_extra("pyvista")
+    grid = pv.read(tmp_path / "s.vtu")
+    assert grid.cell_data["S"].shape == (len(F), 9) and grid.point_data["Sv"].shape == (len(V), 9)
+    np.testing.assert_array_equal(grid.cell_data["S"].reshape(-1, 3, 3), S)
+
+
+def test_to_pyvista_flattens_tensors_and_shows_H(mesh, tmp_path):
+    """(n, 3, 3) results become (n, 9) arrays on points and cells (pyvista refuses 3-d
+    point data); H is the active scalars unless ``scalars=`` says otherwise, and the
+    .vtp pyvista writes keeps both."""
+    pv = require_test_extra("pyvista")
+    V, F = mesh
+    S = igl_hhj.shape_operator(V, F)
+    est = baselines.hhj_vertex(V, F)
+    p = interop.to_pyvista(V, F, {"H": est.H, "Sv": np.repeat(S[:1], len(V), axis=0), "S": S})
+    assert p.point_data["Sv"].shape == (len(V), 9) and p.cell_data["S"].shape == (len(F), 9)
+    assert p.point_data.active_scalars_name == "H"
+    p.save(tmp_path / "p.vtp")
+    back = pv.read(tmp_path / "p.vtp")
+    assert back.point_data.active_scalars_name == "H"
+    np.testing.assert_array_equal(back.cell_data["S"].reshape(-1, 3, 3), S)
+    assert interop.to_pyvista(V, F, est, scalars="K").point_data.active_scalars_name == "K"
+    with pytest.raises(ValueError, match="scalars='Q' is not one of the results"):
+        interop.to_pyvista(V, F, est, scalars="Q")
 
 
 class _FakeGrid:
@@ -163,7 +185,7 @@ def test_unstructured_grid_of_triangles_is_a_mesh_object(mesh):
 
 
 def test_real_pyvista_unstructured_grid(mesh):
-    pv = pytest.importorskip("pyvista")
+    pv = require_test_extra("pyvista")
     V, F = mesh
     grid = pv.PolyData(V, np.column_stack([np.full(len(F), 3), F]).ravel()).cast_to_unstructured_grid()
     V2, F2 = interop.mesh_arrays(grid)

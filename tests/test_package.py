@@ -52,3 +52,13 @@ def test_extras_and_license():
     assert {"matplotlib", "triangle", "gpytoolbox"} <= names["demos"]
     assert any("demos" in r and "benchmark" in r for r in extras["all"])
     assert (root / "LICENSE").read_text().startswith("Mozilla Public License Version 2.0")
+
+
+def test_a_plain_install_annotates_screenshots():
+    """Issue 26 (1): ``pip install . && igl-hhj demo`` must draw the titles and colour bars,
+    so matplotlib (and with it Pillow, for the palette PNGs) is a core dependency."""
+    import tomllib
+    from pathlib import Path
+    root = Path(__file__).resolve().parents[1]
+    deps = tomllib.loads((root / "pyproject.toml").read_text())["project"]["dependencies"]
+    assert "matplotlib" in {r.split(">")[0].split("[")[0].split("=")[0].strip() for r in deps}

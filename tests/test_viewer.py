@@ -59,7 +59,7 @@ def _buffer_size(sname, qname):
 # --------------------------------------------------------------------------- registration (mock)
 def test_register_curvature_faces_and_vertices(mock, ellipsoid):
     V, F = ellipsoid
-    reg = viewer.register_curvature(V, F, name="ell", enabled="k2")
+    reg = viewer.register_curvature(V, F, name="ell", enabled="k2", robust=None)   # full range
     assert list(reg.structures) == ["ell"] and ps.has_surface_mesh("ell")
     for lab in CURV:
         for where, n in (("faces", len(F)), ("vertices", len(V))):
@@ -119,7 +119,7 @@ def test_register_comparison_shares_ranges(mock, ellipsoid):
         a = reg.quantities[("cmp HHJ", f"{lab} (HHJ faces)")]
         b = reg.quantities[("cmp libigl", f"{lab} (libigl vertices)")]
         assert a.vminmax == b.vminmax == reg.ranges[q]
-        assert reg.ranges[q] == viewer.color_range(a.values, b.values)
+        assert reg.ranges[q] == viewer.color_range(a.values, b.values, robust=1.0)   # the default
     assert _buffer_size("cmp libigl", "Gauss K (libigl vertices)") == len(V)
     # the libigl copy is translated along x so the two do not overlap
     width = V[:, 0].max() - V[:, 0].min()
@@ -450,7 +450,7 @@ def test_titles_and_turned_copies(mock, ellipsoid):
     for key, q in plain.quantities.items():
         np.testing.assert_allclose(turned.quantities[key].values, q.values)
     # colour bars: one per (label, range, colour map) shown
-    assert viewer._colour_bars(plain) == [("mean curvature H", plain.ranges["H"], "coolwarm")]
+    assert viewer._colour_bars(plain) == [("mean curvature H [1/length unit]", plain.ranges["H"], "coolwarm")]
 
 
 def test_screenshot_has_a_colour_bar(egl, sphere, tmp_path):
@@ -476,3 +476,18 @@ def test_interactive_layout_leaves_the_panel_free(egl, ellipsoid):
     hi = max(viewer._REGISTERED[n][1, 0] for n in ("win HHJ", "win libigl"))
     left_px, right_px = 600 + (lo - cx) / wpp, 600 + (hi - cx) / wpp
     assert viewer.PANEL_PX <= left_px and right_px <= 1200, (left_px, right_px)
+
+
+def test_register_curvature_defaults_to_the_robust_range(sphere):
+    """Issue 26 (8): the viewer's default colour range is the 1st-99th percentile one
+    the command line uses (--robust 1), so one outlier does not wash the picture out."""
+    V, F = sphere
+    viewer.init("openGL_mock")
+    est = viewer.curvature_estimate(V, F, method="hhj", per="face")
+    est.H[0] = 1e6                                               # one wild value
+    reg = viewer.register_curvature(V, F, est, name="robust")
+    assert reg.ranges["H"] == viewer.color_range(est.H, robust=1.0) and reg.ranges["H"][1] < 10
+    assert viewer.register_curvature(V, F, est, name="full", robust=None).ranges["H"][1] == 1e6
+    cmp = viewer.register_comparison(V, F, name="cmp")
+    assert cmp.ranges["H"][1] < 10
+    ps.remove_all_structures()

@@ -3,7 +3,8 @@
 From a source checkout the same demos run as ``python demos/NAME.py`` (thin
 wrappers around these modules).  Each demo's ``--help`` says what the picture
 shows and which numbers it prints.  Some need the ``demos`` extra
-(``pip install "igl-hhj[demos]"``: matplotlib, triangle, gpytoolbox).
+(``pip install ".[demos]"`` in a checkout: triangle, gpytoolbox); without it they
+stop with that command and exit code 2.
 
 =====================  ==========================================================
 ``quickstart``         a mesh file to a curvature picture and saved results, step by step
@@ -41,9 +42,19 @@ def run(name: str, argv: Sequence[str] | None = None, prog: str | None = None) -
     """
     if name not in DEMOS:
         raise ValueError(f"unknown demo {name!r}; choose one of {', '.join(DEMOS)}")
+    from ..errors import install_hint, missing_optional
     module = importlib.import_module(f".{name}", __name__)
+    prog = prog or f"igl-hhj demo {name}"
     try:
-        module.main(list(argv or []), prog=prog or f"igl-hhj demo {name}")
+        module.main(list(argv or []), prog=prog)
     except SystemExit as exc:           # argparse --help / errors, _common.fail
         return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+    except ModuleNotFoundError as exc:  # an optional package the demo needs (the demos extra)
+        package = missing_optional(exc)
+        if package is None:
+            raise
+        import sys
+        print(f"{prog}: error: this demo needs the '{package}' package: {install_hint(package)}",
+              file=sys.stderr)
+        return 2
     return 0

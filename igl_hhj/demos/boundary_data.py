@@ -50,8 +50,8 @@ def sequence(name, n_levels):
             return WalkerSaddle(), saddle_sequence(n_levels, pre_refine=1)
         return WalkerDumbbell(), dumbbell_sequence(n_levels, pre_refine=1)
     except ImportError as exc:
-        _common.fail(f"the {name} meshes need the '{exc.name}' package: "
-                     f"pip install \"igl-hhj[demos]\" (or pip install {exc.name})")
+        from igl_hhj.errors import install_hint
+        _common.fail(f"the {name} meshes need the '{exc.name}' package: {install_hint(exc.name or 'triangle')}")
 
 
 def face_errors(mesh, S, surface):

@@ -14,7 +14,7 @@ The steps, each one line of library code (read this file: it is the example):
    colour bar, the view with the largest projected area
    (igl_hhj.viewer.register_comparison(..., screenshot=...), headless EGL);
 5. save the results for other tools: .ply (MeshLab colours by its quality =
-   H), .vtu (ParaView / pyvista; when meshio is installed) and .npz (numpy).
+   H), .vtp (ParaView / pyvista open it coloured by H) and .npz (numpy).
 
 What you see: MESH_H.png in --out-dir (or the --screenshot PNG): two copies of the mesh, left HHJ per
 face, right libigl's quadric fit per vertex, coloured by the mean curvature H
@@ -50,12 +50,17 @@ def generated_mesh(folder):
 def main(argv=None, prog=None):
     p = _common.parser(__doc__, prog=prog, size=(1200, 560))
     p.add_argument("mesh", nargs="?", help="mesh file (default: a generated torus written to --out-dir)")
-    p.add_argument("--out-dir", default=".", metavar="DIR", help="where the picture and files go (default .)")
+    p.add_argument("--out-dir", default=".", metavar="DIR",
+                   help="where the picture and files go, created if missing (default .)")
     p.add_argument("--no-screenshot", action="store_true", help="skip step 4 (no EGL needed)")
     args = p.parse_args(argv)
     out = Path(args.out_dir)
-    if not out.is_dir():
-        _common.fail(f"--out-dir {out}: no such directory")
+    try:
+        out.mkdir(parents=True, exist_ok=True)          # created when missing, like batch -o
+    except FileExistsError:
+        _common.fail(f"--out-dir {out}: is a file, not a folder")
+    except OSError as exc:
+        _common.fail(f"--out-dir {out}: cannot create it: {exc.strerror or exc}")
 
     import igl_hhj
     from igl_hhj import baselines, mesh_io, mesh_report
@@ -97,13 +102,8 @@ def main(argv=None, prog=None):
     # 5. save
     est = baselines.hhj_vertex(V, F)
     written = []
-    for ext in (".ply", ".vtu", ".npz"):
+    for ext in (".ply", ".vtp", ".npz"):
         target = out / f"{stem}_curvature{ext}"
-        try:
-            mesh_io.check_output_path(target)
-        except mesh_io.MeshFileError as exc:          # e.g. .vtu without meshio
-            print(f"   ({exc})")
-            continue
         mesh_io.write_curvature(target, np.asarray(V, float), np.asarray(F), est, method="hhj")
         written.append(str(target))
     print(f"5. saved {', '.join(written)}")

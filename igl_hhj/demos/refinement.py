@@ -78,7 +78,8 @@ def plot(rows, path):
                          [lab for lab, _ in METHODS], ylabel="relative L2 error of H", eoc_labels=True,
                          title="re-jittered ellipsoid meshes", path=path)
     except ImportError as exc:
-        _common.fail(f"--plot needs matplotlib: pip install \"igl-hhj[demos]\" ({exc})")
+        from igl_hhj.errors import install_hint
+        _common.fail(f"--plot needs matplotlib: {install_hint('matplotlib')} ({exc})")
     print(f"wrote {path}")
 
 
