@@ -285,15 +285,18 @@ def test_no_picture_without_a_renderer(mock, sphere):
 
 
 def test_to_image_is_the_screenshot(egl, sphere, tmp_path):
-    """to_image returns exactly the picture screenshot writes: (H, W, 4) uint8, opaque;
-    with and without titles / colour bars; reg.screenshot is left alone."""
+    """to_image returns the picture screenshot writes before its palette reduction: (H, W, 4)
+    uint8, opaque, the PNG's pixels within the palette's rounding (mean ≤ 2 levels, no pixel's
+    colour off by more than the palette's worst cell); with and without titles / colour bars;
+    reg.screenshot is left alone."""
     V, F = sphere
     reg = viewer.register_curvature(V, F, name="s", per="face")
     for annotate in (True, False):
         im = viewer.to_image(reg, size=(320, 240), annotate=annotate)
         assert im.shape == (240, 320, 4) and im.dtype == np.uint8 and (im[..., 3] == 255).all()
         viewer.screenshot(tmp_path / f"s{annotate}.png", reg, size=(320, 240), annotate=annotate)
-        np.testing.assert_array_equal(im[..., :3], _decode_png(tmp_path / f"s{annotate}.png")[..., :3])
+        diff = np.abs(im[..., :3].astype(int) - _decode_png(tmp_path / f"s{annotate}.png")[..., :3].astype(int))
+        assert diff.mean() <= 2.0 and np.percentile(diff, 99.9) <= 40
     assert reg.screenshot == str(tmp_path / "sFalse.png")
     viewer.to_image(reg, size=(64, 64))
     assert reg.screenshot == str(tmp_path / "sFalse.png")
