@@ -85,7 +85,7 @@ IN_PROCESS_MAX_FILES = 4
 GROUP_BYTES = 400_000
 """Consecutive input files are grouped into one Dask task until their sizes add up to
 this many bytes (about 8k faces of ascii OFF); larger files are one task each.
-``python -m igl_hhj.benchmarks.batch`` compares it with one mesh per task (README, "Many meshes")."""
+``python -m igl_hhj.benchmarks.batch`` compares it with one mesh per task (igl_hhj/docs/batch.md, "Throughput")."""
 
 GROUP_MAX = 16
 """At most this many meshes per task."""

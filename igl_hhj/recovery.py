@@ -24,7 +24,7 @@ few sparse products:
   O(h⁴) in smooth regions and the O(h) rate of S_h is kept.
 
 Costs (``python -m igl_hhj.benchmarks.robustness --timing``) are reported in
-the README section "Noisy scans and open meshes".
+igl_hhj/docs/results.md, "Noisy scans and open meshes".
 """
 from __future__ import annotations
 

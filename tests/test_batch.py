@@ -357,7 +357,7 @@ def loopback_cluster(tmp_path_factory):
         import json
         address = json.loads(sched_file.read_text())["address"]
         assert address.startswith("tcp://127.0.0.1:")
-        # the worker configuration README "Many meshes" recommends
+        # the worker configuration igl_hhj/docs/batch.md ("Starting a cluster") recommends
         (d / "dask").mkdir()
         (d / "dask" / "igl-hhj.yaml").write_text(
             "distributed:\n  nanny:\n    pre-spawn-environ:\n      MALLOC_TRIM_THRESHOLD_: null\n")

@@ -369,7 +369,7 @@ def test_walker_tables_orders_cli(tmp_path, capsys):
     main(["--orders", "2", "--surfaces", "saddle", "--curved-levels", "2", "--curved-cond-levels", "1",
           "--out", str(tmp_path)])
     text = (tmp_path / "walker_tables_curved.md").read_text(encoding="utf-8")
-    assert "### saddle, m = 2" in text and "| paper 1 |" in text and "κ(S^m) condensed" in text
+    assert "## saddle, m = 2" in text and "| paper 1 |" in text and "κ(S^m) condensed" in text
     rows = [r for r in text.splitlines() if r.startswith("| 1 | 1792")]
     eoc_S = float(rows[0].split("|")[5].split("(")[1].rstrip(") "))
     assert eoc_S > 1.8

@@ -214,7 +214,7 @@ def run(n=200, seed=0, mesh_dir=None, workers=(1, 2), chunks=4, workdir=None, pr
 
 
 def markdown(res):
-    """The README table of :func:`run`'s result."""
+    """The throughput table (igl_hhj/docs/batch.md) of :func:`run`'s result."""
     n, nf, loop = res["meshes"], res["faces"], res["configs"]["loop"]
     lines = ["| configuration | wall time | meshes/s | faces/s | speed-up over the loop |",
              "|---|---:|---:|---:|---:|"]

@@ -81,7 +81,7 @@ def format_table(lab, g, rows):
     keys = ("K2", "Kinf", "H2", "Hinf")
     hs = [r["h"] for r in rows]
     rates = {k: np.concatenate([[np.nan], eoc([r[k] for r in rows], hs)]) for k in keys}
-    lines = [f"### Heine ({lab}), degree γ = {g}", "",
+    lines = [f"## Heine ({lab}), degree γ = {g}", "",
              "| h_max | #F | E_K,2 | E_K,∞ | E_H,2 | E_H,∞ |", "|---|---|---|---|---|---|"]
     for i, r in enumerate(rows):
         cells = [f"{r[k]:.2g}" + ("" if not np.isfinite(rates[k][i]) else f" ({rates[k][i]:.2f})") for k in keys]

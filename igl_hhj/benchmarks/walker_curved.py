@@ -250,7 +250,7 @@ def format_curved_table(name, m, rows, m1_cond=None):
     hs = [r["h"] for r in rows]
     rates = {key: np.concatenate([[np.nan], eoc([r[key] for r in rows], hs)]) if len(rows) > 1
              else np.array([np.nan]) for key in KEYS}
-    lines = [f"### {name}, m = {m} (HHJ r = {m - 1}) — boundary: {BOUNDARY[name]}", "",
+    lines = [f"## {name}, m = {m} (HHJ r = {m - 1}) — boundary: {BOUNDARY[name]}", "",
              "| k | #F | h | " + " | ".join(HEAD) + " | s |", "|---|---|---|" + "---|" * (len(HEAD) + 1)]
     for k, r in enumerate(rows):
         cells = [f"{_fmt(r[key])}{_fmt_eoc(rates[key][k])}" for key in KEYS]

@@ -263,7 +263,7 @@ def format_table(name, rows):
              else np.array([np.nan]) for key in KEYS + ("S_inf_centroid",)}
     lines = []
     bnd = "no boundary data (plain assembly)" if name.endswith("_plain") else paper["boundary"]
-    title = f"### {base} — Walker Table {paper['table']}, boundary: {bnd}"
+    title = f"## {base} — Walker Table {paper['table']}, boundary: {bnd}"
     lines += [title, ""]
     lines.append("| k | #F | h | " + " | ".join(HEAD) + " | ‖S‖L∞ entry@centroid | min ∠ |")
     lines.append("|---|---|---|" + "---|" * (len(HEAD) + 2))

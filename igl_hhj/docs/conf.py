@@ -1,13 +1,25 @@
-"""Sphinx configuration of the igl_hhj API reference (built by tests/test_docs.py with -W)."""
+"""Sphinx configuration of the igl_hhj documentation (built by tests/test_docs.py with -W).
+
+Pages are Markdown (MyST) or reStructuredText; the pictures are referenced where they
+live, in ``demos/images/`` of the source tree (``../../demos/images/NAME.png`` from
+here), and Sphinx copies them into the build's ``_images/``.  Build:
+``python -m sphinx -W -b html igl_hhj/docs build/html``.
+"""
 project = "igl_hhj"
 author = "igl_hhj contributors"
-extensions = ["sphinx.ext.autodoc", "sphinx.ext.napoleon"]
+extensions = ["sphinx.ext.autodoc", "sphinx.ext.napoleon", "sphinx.ext.mathjax", "myst_parser"]
+source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 napoleon_google_docstring = False
 napoleon_numpy_docstring = True
 napoleon_custom_sections = [("Files", "params_style"), ("Repairs", "notes_style")]
 autodoc_typehints = "description"
 autodoc_member_order = "bysource"
-html_theme = "alabaster"
+# $...$ / $$...$$ math in the Markdown pages (rendered by MathJax); heading anchors so
+# that links like results.md#noisy-scans-and-open-meshes resolve
+myst_enable_extensions = ["dollarmath"]
+myst_heading_anchors = 3
+html_theme = "furo"
+html_title = "igl_hhj"
 exclude_patterns = ["_build"]
 # the (string) annotations keep numpy's alias names: curvature_of's overloads are shown
 # as signatures, where the expanded ArrayLike union would fill several lines
