@@ -55,7 +55,7 @@ from .mesh import TriangleMesh
 __all__ = [
     "vertex_frames", "transport", "corner_components", "recover", "transport_phases",
     "connection_laplacians", "smoothing_times", "smooth", "principal", "to_tensors",
-    "vertex_stage", "vertex_stage_reference", "smoothing_rtol", "roughness", "adaptive_radius", "transport_phase_components", "SMOOTHING_STEPS", "SMOOTHING_ORDER",
+    "vertex_stage", "vertex_stage_reference", "adaptive_smoothing", "smoothing_rtol", "roughness", "adaptive_radius", "transport_phase_components", "SMOOTHING_STEPS", "SMOOTHING_ORDER",
 ]
 
 SMOOTHING_STEPS = 2
@@ -355,6 +355,24 @@ def smoothing_rtol(rtol):
     return min(1e-3, float(np.sqrt(rtol)))
 
 
+def adaptive_smoothing(mesh: TriangleMesh, X, C0, mass, phase, rough, radius, rtol, maxiter=500):
+    """The smoothing of :func:`vertex_stage` with this module's parameters, in place on
+    ``X`` (#V, 3): one compiled call (:func:`igl_hhj.kernels.intrinsic_smoothing`: pilot step,
+    adaptive per-face radius, twiced smoothing), every solve to :func:`smoothing_rtol` of
+    the caller's ``rtol``.  ``C0, mass`` from :func:`igl_hhj.recovery.smoothing_coefficients`,
+    ``phase`` from :func:`igl_hhj.kernels.transport_phases`, ``rough`` from the recovery.
+
+    Returns ``(status, iterations, components, radius (#F,))`` (status 0: every solve converged;
+    else X is unchanged)."""
+    from . import kernels
+    from .recovery import SMOOTHING_PER_RADIUS, _kernel_coefficients
+    srtol = smoothing_rtol(rtol)
+    return kernels.intrinsic_smoothing(
+        mesh, X, C0, mass, phase, rough, radius, per_radius=SMOOTHING_PER_RADIUS, pilot_radius=PILOT_RADIUS,
+        pilot_rtol=srtol, gain=ADAPTIVE_GAIN, power=ADAPTIVE_POWER, bounds=ADAPTIVE_RANGE,
+        steps=SMOOTHING_STEPS, coefficients=_kernel_coefficients(SMOOTHING_ORDER), rtol=srtol, maxiter=maxiter)
+
+
 def vertex_stage(mesh: TriangleMesh, S, radius, *, rtol=None, maxiter=500, info=None):
     """The drop-in's vertex stage, compiled: intrinsic patch recovery + twiced smoothing.
 
@@ -375,7 +393,7 @@ def vertex_stage(mesh: TriangleMesh, S, radius, *, rtol=None, maxiter=500, info=
     N : (#V, 3) the vertex normals (``mesh.vertex_normals``).
     """
     from . import kernels
-    from .recovery import QUALITY_FLOOR, SMOOTHING_PER_RADIUS, _kernel_coefficients, smoothing_coefficients
+    from .recovery import QUALITY_FLOOR, smoothing_coefficients
     from .solvers import DEFAULT_RTOL
     rtol = DEFAULT_RTOL if rtol is None else rtol
     N = mesh.vertex_normals
@@ -387,13 +405,9 @@ def vertex_stage(mesh: TriangleMesh, S, radius, *, rtol=None, maxiter=500, info=
     del S
     if not radius > 0:
         return X, N
-    srtol = smoothing_rtol(rtol)
     C0, m = smoothing_coefficients(mesh, w)
     phase = kernels.transport_phases(mesh, N)
-    status, its, ncomp, r = kernels.intrinsic_smoothing(
-        mesh, X, C0, m, phase, rough, radius, per_radius=SMOOTHING_PER_RADIUS, pilot_radius=PILOT_RADIUS,
-        pilot_rtol=srtol, gain=ADAPTIVE_GAIN, power=ADAPTIVE_POWER, bounds=ADAPTIVE_RANGE,
-        steps=SMOOTHING_STEPS, coefficients=_kernel_coefficients(SMOOTHING_ORDER), rtol=srtol, maxiter=maxiter)
+    status, its, ncomp, r = adaptive_smoothing(mesh, X, C0, m, phase, rough, radius, rtol, maxiter)
     if info is not None:
         info.update(smoothing_iterations=its, components=ncomp, radius_median=float(np.median(r)))
     if status != 0:          # a solve stalled (the kernel left X unchanged): the direct reference

@@ -379,11 +379,7 @@ def copy_bandwidth(megabytes=256):
     ``megabytes`` float64 array (bytes read + written / time)."""
     a = np.ones(megabytes * (1 << 20) // 8)
     b = np.empty_like(a)
-    best = np.inf
-    for _ in range(3):
-        t = time.perf_counter()
-        np.copyto(b, a)
-        best = min(best, time.perf_counter() - t)
+    best, _ = _best(lambda: np.copyto(b, a), 3)
     return 2 * a.nbytes / best
 
 
@@ -423,13 +419,13 @@ def profile_stages(V, F, rtol=None, radius=5):
     bandwidth = copy_bandwidth()
     out, faults, floor = {}, {}, {}
 
-    def stage(name, fn, inputs=(), passes=1):
+    def stage(name, fn, inputs=()):
         f0 = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
         t = time.perf_counter()
         r = fn()
         out[name] = time.perf_counter() - t
         faults[name] = resource.getrusage(resource.RUSAGE_SELF).ru_minflt - f0
-        floor[name] = _nbytes(inputs, r) * passes / bandwidth
+        floor[name] = _nbytes(inputs, r) / bandwidth
         return r
     rtol = rtol or solvers.DEFAULT_RTOL
     Vf, Fi = np.ascontiguousarray(V, dtype=np.float64), np.ascontiguousarray(F, dtype=np.int64)
@@ -455,13 +451,8 @@ def profile_stages(V, F, rtol=None, radius=5):
                          (Vf, Fi, S, N, w))
         C, mass = stage("smoothing coefficients", lambda: recovery.smoothing_coefficients(m, w), (Vf, Fi, w))
         phase = stage("transport phases", lambda: kernels.transport_phases(m, N), (N, m.edges))
-        srtol = intrinsic.smoothing_rtol(rtol)
-        res = stage("smoothing (pilot + adaptive radius + twiced)", lambda: kernels.intrinsic_smoothing(
-            m, X, C, mass, phase, rough, radius, per_radius=recovery.SMOOTHING_PER_RADIUS,
-            pilot_radius=intrinsic.PILOT_RADIUS, pilot_rtol=srtol, gain=intrinsic.ADAPTIVE_GAIN,
-            power=intrinsic.ADAPTIVE_POWER, bounds=intrinsic.ADAPTIVE_RANGE, steps=intrinsic.SMOOTHING_STEPS,
-            coefficients=recovery._kernel_coefficients(intrinsic.SMOOTHING_ORDER), rtol=srtol, maxiter=500),
-            (Vf, Fi, C, mass, phase, rough, X))
+        res = stage("smoothing (pilot + adaptive radius + twiced)", lambda: intrinsic.adaptive_smoothing(
+            m, X, C, mass, phase, rough, radius, rtol), (Vf, Fi, C, mass, phase, rough, X))
         its = res[1]
         # per Jacobi-CG iteration: the Laplacian's edge weights and phases, ~6 (#V, 3) vectors
         floor["smoothing (pilot + adaptive radius + twiced)"] = max(1, its) * _nbytes(
@@ -500,20 +491,14 @@ def markdown(rows):
 
 def tiny_meshes():
     """The fixed-cost meshes of :func:`tiny_study`: ``[(name, V, F)]`` with 8-1,280 faces,
-    closed and open (a cube, the icospheres 0-3, a coarse torus, an open jittered grid)."""
-    from ..surfaces import icosphere, square_grid
+    closed and open (a cube, the icospheres 0-3, a coarse jittered torus, an open jittered grid)."""
+    from ..surfaces import icosphere, square_grid, torus_coarse
     V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]], float)
     F = np.array([[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4], [1, 2, 6], [1, 6, 5],
                   [2, 3, 7], [2, 7, 6], [3, 0, 4], [3, 4, 7]])
     out = [("octahedron", *_octahedron()), ("cube", V, F)]
     out += [(f"icosphere({n})", *icosphere(n)) for n in range(4)]
-    u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 9)[:-1], np.linspace(0, 2 * np.pi, 7)[:-1], indexing="ij")
-    Vt = np.c_[((2 + np.cos(v)) * np.cos(u)).ravel(), ((2 + np.cos(v)) * np.sin(u)).ravel(), np.sin(v).ravel()]
-    i, j = np.meshgrid(np.arange(8), np.arange(6), indexing="ij")
-    a, b = i * 6 + j, ((i + 1) % 8) * 6 + j
-    c, d = ((i + 1) % 8) * 6 + (j + 1) % 6, i * 6 + (j + 1) % 6
-    Ft = np.r_[np.c_[a.ravel(), b.ravel(), c.ravel()], np.c_[a.ravel(), c.ravel(), d.ravel()]]
-    out.append(("torus 96", Vt, Ft))
+    out.append(("torus 96", *torus_coarse(n_phi=8, n_t=6)))
     P, Fg = square_grid(8, amount=0.3, seed=3)
     out.append(("open grid", np.c_[P, 0.3 * P[:, 0] * P[:, 1]], Fg))
     return out
