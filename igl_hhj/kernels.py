@@ -288,9 +288,9 @@ def envelope_ldl_solve(indptr, indices, data, R, resid_rtol):
     (no pivoting) in the compiled core, for the tiny systems where building scipy
     sparse matrices and a QDLDL factor costs more than the factorisation itself.
 
-    Row ``i`` is stored from its first nonzero column on (the factor keeps that envelope):
-    O(Σ_i bandwidth_i²) flops, O(n²) memory, so only for n ≲ a few hundred
-    (:data:`igl_hhj.solvers.ENVELOPE_MAX`).  Reference: :func:`igl_hhj.solvers.cholesky_solve`.
+    Row ``i`` is stored packed from its first nonzero column to the diagonal (the factor
+    keeps that envelope): O(Σ_i bandwidth_i²) flops and O(Σ_i bandwidth_i) memory, so only
+    for n ≲ a few hundred (:data:`igl_hhj.solvers.ENVELOPE_MAX`).  Reference: :func:`igl_hhj.solvers.cholesky_solve`.
 
     Returns
     -------

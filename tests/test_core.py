@@ -708,6 +708,12 @@ def test_envelope_ldl_agrees_with_the_sparse_direct_solve():
     assert status == 0
     Y = solvers.cholesky_solve(system.csr(), R)
     assert np.abs(X - Y).max() <= 1e-12 * np.abs(Y).max()
+    # a larger system: its packed envelope (~1 MB) lives in its own mapping, not the heap
+    big = solvers.HHJSystem(as_mesh(*icosphere(3)))
+    R = rng.standard_normal((big.n, 3))
+    X, status = kernels.envelope_ldl_solve(big.indptr, big._cols_flat, big.A.ravel(), R, 1e-8)
+    Y = solvers.cholesky_solve(big.csr(), R)
+    assert status == 0 and np.abs(X - Y).max() <= 1e-12 * np.abs(Y).max()
     # a singular matrix: the unpivoted factorisation stops and says so
     indptr = np.array([0, 2, 4])
     cols = np.array([0, 1, 0, 1], dtype=np.int32)
