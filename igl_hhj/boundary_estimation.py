@@ -22,7 +22,7 @@ import scipy.sparse as sp
 
 from .mesh import TriangleMesh
 
-__all__ = ["estimate_boundary_normals", "BOUNDARY_TREATMENTS"]
+__all__ = ["estimate_boundary_normals", "boundary_normal_fits_reference", "BOUNDARY_TREATMENTS"]
 
 BOUNDARY_TREATMENTS = ("estimate", "plain")
 """``boundary=`` values: "estimate" (clamped with :func:`estimate_boundary_normals`,
@@ -88,7 +88,33 @@ def _fit_normals(X, verts, row, col, N0, scale):
     return Nn, ok
 
 
-def estimate_boundary_normals(mesh: TriangleMesh, rings=3):
+def boundary_normal_fits_reference(mesh: TriangleMesh, verts, rings, N0):
+    """The two quadric fits of :func:`estimate_boundary_normals` (numpy reference of
+    :func:`igl_hhj.kernels.boundary_normal_fits`): at each vertex of ``verts`` (n,) over
+    its ``rings``-ring (one ring more where that has fewer than 10 vertices), the first
+    in the frame of N0 (n, 3), the second in the frame of the first's normal.  Returns
+    (n, 3): the second normal where both fits are well posed, else N0."""
+    X = mesh.V
+    # spacing of each fit: mean edge length at the vertex, for conditioning only
+    e = mesh.edges
+    s = np.bincount(e.ravel(), weights=np.repeat(mesh.unique_edge_lengths, 2), minlength=mesh.n_vertices)
+    c = np.bincount(e.ravel(), minlength=mesh.n_vertices)
+    scale = (s / np.maximum(c, 1))[verts]
+    row, col = _ring_pairs(mesh, verts, rings)
+    # corners and other vertices with a thin neighbourhood: one more ring
+    thin = np.flatnonzero(np.bincount(row, minlength=len(verts)) < 10)
+    if thin.size:
+        r3, c3 = _ring_pairs(mesh, verts[thin], rings + 1)
+        keep = ~np.isin(row, thin)
+        row = np.concatenate([row[keep], thin[r3]])
+        col = np.concatenate([col[keep], c3])
+    N1, ok = _fit_normals(X, verts, row, col, N0, scale)
+    N1 = np.where(ok[:, None], N1, N0)
+    N2, ok2 = _fit_normals(X, verts, row, col, N1, scale)
+    return np.where((ok & ok2)[:, None], N2, N0)
+
+
+def estimate_boundary_normals(mesh: TriangleMesh, rings=3, *, reference=False):
     """O(h²) unit normals at the boundary vertices from local quadric fits.
 
     Parameters
@@ -99,6 +125,9 @@ def estimate_boundary_normals(mesh: TriangleMesh, rings=3):
         (corners) use one ring more.  Wider fits pass less normal noise into
         the clamped data and cost a larger constant on clean meshes; all keep
         the O(h²) rate (``tests/test_recovery.py``).
+    reference : bool, default False
+        Fit with the numpy reference :func:`boundary_normal_fits_reference` instead of
+        the compiled :func:`igl_hhj.kernels.boundary_normal_fits` (the same to round-off).
 
     Returns
     -------
@@ -120,26 +149,13 @@ def estimate_boundary_normals(mesh: TriangleMesh, rings=3):
     verts = np.flatnonzero(mesh.boundary_vertices)
     if verts.size == 0:
         return out
-    X = mesh.V
-    row, col = _ring_pairs(mesh, verts, rings)
-    # corners and other vertices with a thin neighbourhood: one more ring
-    thin = np.flatnonzero(np.bincount(row, minlength=len(verts)) < 10)
-    if thin.size:
-        r3, c3 = _ring_pairs(mesh, verts[thin], rings + 1)
-        keep = ~np.isin(row, thin)
-        row = np.concatenate([row[keep], thin[r3]])
-        col = np.concatenate([col[keep], c3])
-    # spacing of each fit: mean edge length at the vertex, for conditioning only
-    e = mesh.edges
-    le = mesh.unique_edge_lengths
-    s = np.bincount(e.ravel(), weights=np.repeat(le, 2), minlength=nV)
-    c = np.bincount(e.ravel(), minlength=nV)
-    scale = (s / np.maximum(c, 1))[verts]
     N0 = mesh.vertex_normals[verts]
-    N1, ok = _fit_normals(X, verts, row, col, N0, scale)
-    N1 = np.where(ok[:, None], N1, N0)
-    N2, ok2 = _fit_normals(X, verts, row, col, N1, scale)
-    N = np.where((ok & ok2)[:, None], N2, N0)
+    if reference:
+        N = boundary_normal_fits_reference(mesh, verts, rings, N0)
+    else:
+        from . import kernels
+        N = kernels.boundary_normal_fits(mesh, verts, rings, N0)
+    e = mesh.edges
     # fallback: mean normal of the faces of the vertex's boundary edges
     be = np.flatnonzero(mesh.boundary_edges)
     f = mesh.edge_faces[be, 0]

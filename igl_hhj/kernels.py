@@ -516,6 +516,23 @@ def transport_phases(mesh, N):
     return _core.transport_phases(N, _i64(mesh.edges))
 
 
+def boundary_normal_fits(mesh, verts, rings, N0):
+    """The two quadric height fits of :func:`igl_hhj.boundary_estimation.estimate_boundary_normals`
+    at the vertices ``verts`` (n,) over their ``rings``-ring (one more where that ring has
+    fewer than 10 vertices), starting from the normals N0 (n, 3), coordinates scaled by the
+    mean length of each vertex's edges: (n, 3) the second fit's unit normal where both fits
+    are well posed, else N0.  Reference
+    :func:`igl_hhj.boundary_estimation.boundary_normal_fits_reference`."""
+    verts = _i64(verts)
+    N0 = _f64(N0, "N0", (3,))
+    if verts.ndim != 1 or N0.shape[0] != len(verts):
+        raise ValueError("boundary_normal_fits: verts must be (n,) and N0 (n, 3)")
+    if int(rings) < 1:
+        raise ValueError(f"boundary_normal_fits: rings must be >= 1, got {rings}")
+    _threads()
+    return _core.boundary_normal_fits(mesh.V, _i64(mesh.edges), verts, int(rings), N0)
+
+
 def adaptive_radius(mesh, pilot, rough, radius, gain, power, lo, hi):
     """Per-face smoothing radius (#F,); reference :func:`igl_hhj.intrinsic.adaptive_radius`."""
     pilot = _f64(pilot, "pilot", (3,))

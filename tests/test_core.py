@@ -736,3 +736,59 @@ def test_tiny_meshes_take_the_envelope_solve_and_match_the_reference(monkeypatch
     monkeypatch.undo()
     ref = curvature._shape_operator_reference(as_mesh(V, F))
     assert np.abs(S - ref).max() <= 1e-10 * np.abs(ref).max()
+
+
+def _open_meshes_for_boundary_normals():
+    """Open meshes whose boundary normal fits take every branch: a jittered saddle, a
+    jittered cap cut from a sphere, a flat 6×6 grid (its corners' 1-rings have < 10
+    vertices: one ring more), a strip too small for a fit (fewer than 6 neighbours), and
+    a fan whose vertices all lie on two lines (xy ≡ 0: a singular Gram matrix, decided by
+    the eigenvalue test, not the cheap condition bound)."""
+    surface, seq = sequence("saddle", 3)
+    out = {"saddle": seq[-1]}
+    V, F = _bumpy(2)
+    keep = V[F].mean(axis=1)[:, 2] < 0.2
+    out["cap"] = (V, F[keep])
+    n = 6
+    x, y = np.meshgrid(np.linspace(0, 1, n), np.linspace(0, 1, n))
+    Vg = np.c_[x.ravel(), y.ravel(), np.zeros(n * n)]
+    q = np.arange(n * n).reshape(n, n)[:-1, :-1].ravel()
+    Fg = np.r_[np.c_[q, q + 1, q + n + 1], np.c_[q, q + n + 1, q + n]]
+    out["flat grid"] = (Vg, Fg)
+    out["strip"] = (np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.1], [0, 2, 0.3]], float),
+                    np.array([[0, 1, 2], [1, 3, 2], [2, 3, 4]]))
+    Va = np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0], [0, 2, 0], [-1, 0, 0], [-2, 0, 0]], float)
+    out["axes"] = (Va, np.array([[0, 1, 3], [1, 2, 3], [3, 2, 4], [0, 3, 5], [5, 3, 4], [5, 4, 6]]))
+    return out
+
+
+@pytest.mark.parametrize("name", ["saddle", "cap", "flat grid", "strip", "axes"])
+@pytest.mark.parametrize("rings", [1, 3])
+def test_boundary_normal_fits_equal_reference(name, rings):
+    """The compiled quadric fits of estimate_boundary_normals equal the numpy reference."""
+    from igl_hhj.boundary_estimation import boundary_normal_fits_reference, estimate_boundary_normals
+    V, F = _open_meshes_for_boundary_normals()[name]
+    m = TriangleMesh(V, F)
+    verts = np.flatnonzero(m.boundary_vertices)
+    N0 = m.vertex_normals[verts]
+    got = kernels.boundary_normal_fits(m, verts, rings, N0)
+    ref = boundary_normal_fits_reference(m, verts, rings, N0)
+    assert got.shape == (len(verts), 3)
+    assert np.allclose(got, ref, rtol=0, atol=1e-12)
+    a = estimate_boundary_normals(m, rings)
+    b = estimate_boundary_normals(m, rings, reference=True)
+    assert np.array_equal(np.isnan(a), np.isnan(b))
+    assert np.allclose(a[~np.isnan(b)], b[~np.isnan(b)], rtol=0, atol=1e-12)
+
+
+def test_boundary_normal_fits_reject_bad_arrays():
+    V, F = _open_meshes_for_boundary_normals()["saddle"]
+    m = TriangleMesh(V, F)
+    verts = np.flatnonzero(m.boundary_vertices)
+    N0 = m.vertex_normals[verts]
+    with pytest.raises(ValueError, match="boundary_normal_fits"):
+        kernels.boundary_normal_fits(m, verts, 3, N0[:-1])
+    with pytest.raises(ValueError, match="rings"):
+        kernels.boundary_normal_fits(m, verts, 0, N0)
+    with pytest.raises(ValueError, match="out of range"):
+        kernels.boundary_normal_fits(m, np.r_[verts[:-1], m.n_vertices], 3, N0)

@@ -429,6 +429,22 @@ NB_MODULE(_hhj_core, m) {
         return to_numpy(std::move(ph), {(size_t)nE, 2});
     });
 
+    m.def("boundary_normal_fits", [](In<double> X, In<i64> E, In<i64> verts, int rings, In<double> N0) {
+        const i64 nV = X.shape(0), nE = E.shape(0), n = verts.shape(0);
+        need(X.shape(1) == 3 && E.shape(1) == 2 && N0.shape(0) == (size_t)n && N0.shape(1) == 3,
+             "boundary_normal_fits: shapes");
+        need(rings >= 1, "boundary_normal_fits: rings >= 1");
+        for (i64 q = 0; q < 2 * nE; ++q) need(E.data()[q] >= 0 && E.data()[q] < nV, "boundary_normal_fits: E out of range");
+        for (i64 q = 0; q < n; ++q) need(verts.data()[q] >= 0 && verts.data()[q] < nV, "boundary_normal_fits: verts out of range");
+        std::vector<double> N((size_t)n * 3);
+        {
+            nb::gil_scoped_release nogil;
+            hhj::ThreadBudget tb(n * 64);
+            hhj::boundary_normal_fits(X.data(), nV, E.data(), nE, verts.data(), n, rings, N0.data(), N.data(), tb.nt);
+        }
+        return to_numpy(std::move(N), {(size_t)n, 3});
+    });
+
     m.def("adaptive_radius", [](In<double> V, In<i64> F, In<double> P, In<double> rough, double radius,
                                 double gain, double power, double lo, double hi) {
         const i64 nF = F.shape(0), nV = V.shape(0);

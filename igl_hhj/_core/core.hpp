@@ -190,6 +190,9 @@ void vertex_laplacian(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* EL
                       std::vector<double>& L, std::vector<i64>& diag_pos,
                       std::vector<i64>* pos_lo = nullptr, std::vector<i64>* pos_hi = nullptr);
 
+void boundary_normal_fits(const double* X, i64 nV, const i64* E, i64 nE, const i64* verts, i64 n, int rings,
+                          const double* N0, double* N, int nt);
+
 // intrinsic_kernels.cpp
 i64 vertex_groups(i64 nV, const i64* E, i64 nE, std::vector<std::int32_t>& label);
 void transport_phases(const double* N, i64 nV, const i64* E, i64 nE, double* phase, int nt);

@@ -355,4 +355,226 @@ int smooth_vertex_tensors(i64 nV, const i64* E, i64 nE, const i64* EF, const i64
     return 0;
 }
 
+
+// ---------------------------------------------------------------------------------------
+// boundary_normal_fits (boundary_estimation.estimate_boundary_normals, its numpy reference):
+// for each vertex v of verts the vertices of its `rings`-ring in the graph of the unique
+// edges E (rings + 1 where that ring has fewer than 10), and two weighted quadric height
+// fits z = g1 x + g2 y + (a x^2 + 2 b xy + c y^2)/2 through x_v, the first in the frame of
+// N0, the second in the frame of the first's normal.  N (n,3) gets the second normal
+// where both fits are well posed (>= 6 neighbours, finite, Gram condition < 1e10), else N0.
+// Coordinates are scaled by the mean length of v's edges (conditioning only).
+namespace {
+
+// eigenvalues of a symmetric 5x5 matrix (cyclic Jacobi), ascending
+void sym5_eigenvalues(const double (&A)[5][5], double (&lam)[5]) {
+    double a[5][5];
+    for (int i = 0; i < 5; ++i)
+        for (int j = 0; j < 5; ++j) a[i][j] = A[i][j];
+    // quadratic convergence: a handful of sweeps reach off-diagonal entries at the
+    // round-off of the diagonal (an entry below 1e-18 sqrt|a_pp a_qq| is dropped)
+    for (int sweep = 0; sweep < 30; ++sweep) {
+        double off = 0.0, tot = 0.0;
+        for (int i = 0; i < 5; ++i)
+            for (int j = 0; j < 5; ++j) { tot += a[i][j] * a[i][j]; if (i != j) off += a[i][j] * a[i][j]; }
+        if (!(off > 1e-28 * tot)) break;
+        for (int p = 0; p < 4; ++p)
+            for (int q = p + 1; q < 5; ++q) {
+                if (std::fabs(a[p][q]) <= 1e-18 * std::sqrt(std::fabs(a[p][p] * a[q][q]))) { a[p][q] = a[q][p] = 0.0; continue; }
+                const double th = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+                const double t = (th >= 0 ? 1.0 : -1.0) / (std::fabs(th) + std::sqrt(th * th + 1.0));
+                const double c = 1.0 / std::sqrt(t * t + 1.0), s = t * c;
+                for (int k = 0; k < 5; ++k) {
+                    const double akp = a[k][p], akq = a[k][q];
+                    a[k][p] = c * akp - s * akq;
+                    a[k][q] = s * akp + c * akq;
+                }
+                for (int k = 0; k < 5; ++k) {
+                    const double apk = a[p][k], aqk = a[q][k];
+                    a[p][k] = c * apk - s * aqk;
+                    a[q][k] = s * apk + c * aqk;
+                }
+            }
+    }
+    for (int i = 0; i < 5; ++i) lam[i] = a[i][i];
+    std::sort(lam, lam + 5);
+}
+
+// An upper bound of the 2-norm condition number of a symmetric positive definite 5x5
+// matrix, trace(G) trace(G^-1) (>= lam_max / lam_min, at most 25 times it), from its
+// Cholesky factor; infinity when the factorisation fails.
+double sym5_condition_bound(const double (&G)[5][5]) {
+    double L[5][5] = {};
+    double tr = 0.0;
+    for (int j = 0; j < 5; ++j) {
+        tr += G[j][j];
+        double d = G[j][j];
+        for (int k = 0; k < j; ++k) d -= L[j][k] * L[j][k];
+        if (!(d > 0.0)) return INFINITY;
+        L[j][j] = std::sqrt(d);
+        for (int i = j + 1; i < 5; ++i) {
+            double v = G[i][j];
+            for (int k = 0; k < j; ++k) v -= L[i][k] * L[j][k];
+            L[i][j] = v / L[j][j];
+        }
+    }
+    // trace(G^-1) = |L^-1|_F^2, L^-1 column by column (forward substitution on e_c)
+    double tinv = 0.0;
+    for (int c = 0; c < 5; ++c) {
+        double y[5] = {};
+        for (int i = c; i < 5; ++i) {
+            double v = i == c ? 1.0 : 0.0;
+            for (int k = c; k < i; ++k) v -= L[i][k] * y[k];
+            y[i] = v / L[i][i];
+            tinv += y[i] * y[i];
+        }
+    }
+    return tr * tinv;
+}
+
+// x = G^-1 r, Gaussian elimination with partial pivoting (G, r overwritten)
+void solve5(double (&G)[5][5], double (&r)[5], double (&x)[5]) {
+    for (int k = 0; k < 5; ++k) {
+        int piv = k;
+        for (int i = k + 1; i < 5; ++i)
+            if (std::fabs(G[i][k]) > std::fabs(G[piv][k])) piv = i;
+        if (piv != k) {
+            for (int j = 0; j < 5; ++j) std::swap(G[k][j], G[piv][j]);
+            std::swap(r[k], r[piv]);
+        }
+        for (int i = k + 1; i < 5; ++i) {
+            const double f = G[i][k] / G[k][k];
+            for (int j = k; j < 5; ++j) G[i][j] -= f * G[k][j];
+            r[i] -= f * r[k];
+        }
+    }
+    for (int k = 4; k >= 0; --k) {
+        double s = r[k];
+        for (int j = k + 1; j < 5; ++j) s -= G[k][j] * x[j];
+        x[k] = s / G[k][k];
+    }
+}
+
+// frame of boundary_estimation._frames: e1 = N x (the axis of the smallest |N_a|), e2 = N x e1
+void fit_frame(const double* n, double* e1, double* e2) {
+    int ax = 0;
+    double best = std::fabs(n[0]);
+    for (int a = 1; a < 3; ++a)
+        if (std::fabs(n[a]) < best || std::isnan(best)) { best = std::fabs(n[a]); ax = a; }
+    if (std::isnan(std::fabs(n[0]))) ax = 0;
+    double u[3] = {0.0, 0.0, 0.0};
+    u[ax] = 1.0;
+    cross3(n, u, e1);
+    const double l = std::sqrt(dot3(e1, e1));
+    for (int a = 0; a < 3; ++a) e1[a] /= l;
+    cross3(n, e1, e2);
+}
+
+// one fit at a vertex: (N out, ok)
+bool quadric_fit(const double* X, const double* xv, const i64* nb, i64 cnt, const double* n0, double scale,
+                 double* nout) {
+    double e1[3], e2[3];
+    fit_frame(n0, e1, e2);
+    double G[5][5] = {}, r[5] = {};
+    for (i64 q = 0; q < cnt; ++q) {
+        const double* xc = X + 3 * nb[q];
+        double d[3];
+        for (int a = 0; a < 3; ++a) d[a] = (xc[a] - xv[a]) / scale;
+        const double x = dot3(d, e1), y = dot3(d, e2), z = dot3(d, n0);
+        const double w = 1.0 / (1.0 + x * x + y * y);
+        const double phi[5] = {x, y, 0.5 * x * x, x * y, 0.5 * y * y};
+        for (int a = 0; a < 5; ++a) {
+            r[a] += w * phi[a] * z;
+            for (int b = a; b < 5; ++b) G[a][b] += w * phi[a] * phi[b];
+        }
+    }
+    bool finite = true;
+    for (int a = 0; a < 5; ++a) {
+        finite = finite && std::isfinite(r[a]);
+        for (int b = a; b < 5; ++b) { G[b][a] = G[a][b]; finite = finite && std::isfinite(G[a][b]); }
+    }
+    bool ok = cnt >= 6 && finite;
+    // the reference's test, cond = lam_max / lam_min < 1e10; the eigenvalues only where
+    // the cheap bound does not already decide it
+    if (ok && !(sym5_condition_bound(G) < 1e10)) {
+        double lam[5];
+        sym5_eigenvalues(G, lam);
+        const double cond = lam[0] > 0 ? lam[4] / lam[0] : INFINITY;
+        ok = std::isfinite(cond) && cond < 1e10;
+    }
+    double g[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
+    if (ok) solve5(G, r, g);
+    double len2 = 0.0;
+    for (int a = 0; a < 3; ++a) { nout[a] = n0[a] - g[0] * e1[a] - g[1] * e2[a]; len2 += nout[a] * nout[a]; }
+    const double len = std::sqrt(len2);
+    for (int a = 0; a < 3; ++a) nout[a] /= len;
+    return ok;
+}
+
+}  // namespace
+
+void boundary_normal_fits(const double* X, i64 nV, const i64* E, i64 nE, const i64* verts, i64 n, int rings,
+                          const double* N0, double* N, int nt) {
+    std::vector<i64> ptr(nV + 1, 0), adj(2 * nE);
+    for (i64 e = 0; e < nE; ++e) { ++ptr[E[2 * e] + 1]; ++ptr[E[2 * e + 1] + 1]; }
+    for (i64 v = 0; v < nV; ++v) ptr[v + 1] += ptr[v];
+    {
+        std::vector<i64> fill(ptr.begin(), ptr.end() - 1);
+        for (i64 e = 0; e < nE; ++e) {
+            adj[fill[E[2 * e]]++] = E[2 * e + 1];
+            adj[fill[E[2 * e + 1]]++] = E[2 * e];
+        }
+    }
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel num_threads(nt)
+#endif
+    {
+        std::vector<i64> stamp(nV, -1), ring;
+        std::vector<int> depth;
+#ifdef IGL_HHJ_OPENMP
+#pragma omp for schedule(dynamic, 64)
+#endif
+        for (i64 k = 0; k < n; ++k) {
+            const i64 v = verts[k];
+            // breadth-first rings around v (v excluded from the fit's neighbours)
+            auto grow = [&](int depth_max) {
+                ring.clear(); depth.clear();
+                ring.push_back(v); depth.push_back(0);
+                stamp[v] = k;
+                for (size_t h = 0; h < ring.size(); ++h) {
+                    if (depth[h] == depth_max) continue;
+                    const i64 u = ring[h];
+                    for (i64 q = ptr[u]; q < ptr[u + 1]; ++q) {
+                        const i64 w = adj[q];
+                        if (stamp[w] == k) continue;
+                        stamp[w] = k;
+                        ring.push_back(w); depth.push_back(depth[h] + 1);
+                    }
+                }
+            };
+            grow(rings);
+            if ((i64)ring.size() - 1 < 10) {
+                for (i64 u : ring) stamp[u] = -1;
+                grow(rings + 1);
+            }
+            for (i64 u : ring) stamp[u] = -1;
+            // spacing of the fit (conditioning only): the mean length of v's edges
+            double scale = 0.0;
+            for (i64 q = ptr[v]; q < ptr[v + 1]; ++q) {
+                const double* xu = X + 3 * adj[q];
+                scale += std::sqrt((xu[0] - X[3 * v]) * (xu[0] - X[3 * v]) + (xu[1] - X[3 * v + 1]) * (xu[1] - X[3 * v + 1]) +
+                                   (xu[2] - X[3 * v + 2]) * (xu[2] - X[3 * v + 2]));
+            }
+            scale /= (double)std::max<i64>(ptr[v + 1] - ptr[v], 1);
+            const i64* nb = ring.data() + 1;
+            const i64 cnt = (i64)ring.size() - 1;
+            double n1[3], n2[3];
+            const bool ok1 = quadric_fit(X, X + 3 * v, nb, cnt, N0 + 3 * k, scale, n1);
+            const double* start = ok1 ? n1 : N0 + 3 * k;
+            const bool ok2 = quadric_fit(X, X + 3 * v, nb, cnt, start, scale, n2);
+            for (int a = 0; a < 3; ++a) N[3 * k + a] = (ok1 && ok2) ? n2[a] : N0[3 * k + a];
+        }
+    }
+}
+
 }  // namespace hhj
