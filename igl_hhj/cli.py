@@ -107,16 +107,18 @@ class _Stages:
 
 
 def _read(path):
-    """Guarded read; libigl's warnings become one warning line."""
-    from .mesh_io import MeshFileError, read_mesh
+    """Guarded read (:func:`igl_hhj.mesh_io.read_mesh_file`); the reader's warnings become
+    one warning line.  Polygons split into triangles are not a warning: the callers say so."""
+    from .mesh_io import MeshFileError, read_mesh_file
     try:
-        V, F, messages = read_mesh(path)
+        mf = read_mesh_file(path)
     except MeshFileError as exc:
         raise UserError(str(exc), EXIT_UNREADABLE) from None
+    messages = mf.messages
     if messages:
         more = f" (+{len(messages) - 2} more)" if len(messages) > 2 else ""
         print(f"igl-hhj: warning: {path}: " + "; ".join(messages[:2]) + more, file=sys.stderr)
-    return V, F
+    return mf
 
 
 def _check_writable(path, extensions=None):
@@ -269,7 +271,8 @@ def _curvature(args):
             raise UserError(f"--size must be at least 16 16 pixels, got {args.size[0]} {args.size[1]}")
 
     t = time.perf_counter()
-    V, F = _read(args.mesh)
+    mf = _read(args.mesh)
+    V, F = mf.V, mf.F
     try:
         mesh = TriangleMesh(V, F)
     except (ValueError, TypeError) as exc:
@@ -293,6 +296,8 @@ def _curvature(args):
 
     say(f"{args.mesh}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, "
           f"{int(mesh.boundary_edges.sum())} boundary edges")
+    if mf.split.n_split:
+        say(f"  {mf.split.describe()}")
     say(f"  method {args.method} per {per}: {dt:.2f} s")
     if args.method == "hhj":
         say(f"  smoothing scale (--radius): {radius}" + (" (none: Walker's S_h per face)" if radius == 0 else ""))
@@ -417,8 +422,8 @@ def _batch(args):
 # --------------------------------------------------------------------------- info
 def _info(args):
     from .mesh_report import mesh_report
-    V, F = _read(args.mesh)
-    report = mesh_report(V, F)
+    mf = _read(args.mesh)
+    report = mesh_report(mf.V, mf.F, split=mf.split)
     print(f"{args.mesh}")
     for line in report.lines():
         print(f"  {line}")
@@ -502,10 +507,13 @@ def build_parser():
                    help="screenshot size in pixels (default 1600 700)")
     d.set_defaults(func=_demo)
 
-    c = sub.add_parser("curvature", help="curvature of a mesh file (any format libigl reads)",
+    c = sub.add_parser("curvature", help="curvature of a mesh file (libigl's formats, glTF, 3MF, VTK)",
                        description="Principal curvatures k1 >= k2, directions d1, d2, mean H and "
                                    "Gauss K curvature of a triangle mesh (.obj .off .ply .stl .wrl "
-                                   ".mesh .msh). Sign: +1/R on a sphere with outward normals.")
+                                   ".mesh .msh with libigl; .gltf .glb .3mf with trimesh, .vtp .vtu "
+                                   ".vtk with pyvista or meshio). Polygons are split into triangles "
+                                   "(fan from each polygon's first corner). Sign: +1/R on a sphere "
+                                   "with outward normals.")
     c.add_argument("mesh", metavar="MESH")
     c.add_argument("--method", choices=["hhj", "igl", "heine"], default="hhj",
                    help="hhj: Walker's HHJ shape operator (default); igl: igl.principal_curvature "
