@@ -172,6 +172,7 @@ class PolygonMesh:
     point_data : dict name -> (#V, ...) array
     cell_data : dict name -> (#P, ...) array, one row per polygon
     reader : str, the package that read the file
+    active_scalars : str or None, the array the file marks active (pyvista only)
     messages : list of str, what was dropped or merged while reading
     """
 
@@ -182,6 +183,7 @@ class PolygonMesh:
     cell_data: dict = field(default_factory=dict)
     reader: str = ""
     messages: list = field(default_factory=list)
+    active_scalars: str | None = None
 
 
 def _import(package, path):
@@ -318,8 +320,9 @@ def _read_pyvista(path):
         messages.append("ignored cells that are not polygons: "
                         + ", ".join(f"{n} {k}" for k, n in dropped.items()))
     V = np.asarray(ds.points, dtype=np.float64).reshape(-1, 3)
+    active = ds.point_data.active_scalars_name or ds.cell_data.active_scalars_name
     return PolygonMesh(V, I, C, point_data=_arrays(ds.point_data), cell_data=_arrays(ds.cell_data, rows),
-                       reader=f"pyvista {pv.__version__}", messages=messages)
+                       reader=f"pyvista {pv.__version__}", messages=messages, active_scalars=active)
 
 
 def _read_meshio(path):
