@@ -47,11 +47,15 @@ import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .polygon_io import EXTRA_EXTENSIONS, PolygonSplit, polygon_split, read_polygon_mesh, split_polygons
+
+if TYPE_CHECKING:
+    from .baselines import CurvatureEstimate
 
 __all__ = ["MeshFileError", "MeshFile", "read_mesh_file", "READ_EXTENSIONS", "CapturedOutput", "MESH_EXTENSIONS", "OUTPUT_EXTENSIONS", "read_mesh",
            "check_output_path", "probe_writable", "write_curvature", "read_curvature", "CurvatureFile",
@@ -730,8 +734,8 @@ class MeshFile:
     active_scalars : str or None, the array a VTK file marks active (read with pyvista)
     """
 
-    V: np.ndarray
-    F: np.ndarray
+    V: NDArray[np.float64]
+    F: NDArray[np.int64]
     messages: list = field(default_factory=list)
     split: PolygonSplit = field(default_factory=PolygonSplit)
     reader: str = "libigl"
@@ -744,7 +748,7 @@ class MeshFile:
         return list(self.messages) + ([self.split.describe()] if self.split.n_split else [])
 
 
-def read_mesh(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, list[str]]:
+def read_mesh(path: str | os.PathLike) -> tuple[NDArray[np.float64], NDArray[np.int64], list[str]]:
     """Read a triangle mesh, guarded: libigl's formats with ``igl.read_triangle_mesh``,
     the others through optional packages (:mod:`igl_hhj.polygon_io`).
 
@@ -846,7 +850,7 @@ def _read_checked(path, ext, head):
     if exc is not None:
         raise MeshFileError(f"{path}: libigl could not read it: {exc}{_libigl_says(cap.lines)}")
     V = np.asarray(V, dtype=np.float64)
-    F = np.asarray(F)
+    F = np.asarray(F, dtype=np.int64)
     if F.size == 0:
         raise MeshFileError(f"{path}: libigl read no faces from this {ext} file"
                             f"{_libigl_says(cap.lines)}")
@@ -1186,9 +1190,9 @@ class CurvatureFile:
     fields : dict name -> array, every numeric per-element array of the file
     """
 
-    V: np.ndarray
-    F: np.ndarray
-    estimate: Any
+    V: NDArray[np.float64]
+    F: NDArray[np.int64]
+    estimate: CurvatureEstimate
     method: str = ""
     quantity: str = "H"
     S: np.ndarray | None = None

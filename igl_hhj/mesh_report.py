@@ -32,12 +32,16 @@ directions) returns wrong loops; on valid meshes the two agree (tested).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 import warnings
 
 from .mesh import MeshDefectError, MeshWarning, TriangleMesh, zero_area_faces
+
+if TYPE_CHECKING:
+    from .polygon_io import PolygonSplit
 
 __all__ = ["MeshReport", "mesh_report"]
 
@@ -172,7 +176,7 @@ def _repairs(V, F, defect):
                               "functions refuse it unless repair=True")
 
 
-def mesh_report(V, F, split=None):
+def mesh_report(V: Any, F: Any, split: PolygonSplit | None = None) -> MeshReport:
     """Analyse ``(V, F)`` without requiring a valid mesh.
 
     Parameters

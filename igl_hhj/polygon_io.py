@@ -45,6 +45,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 __all__ = ["EXTRA_EXTENSIONS", "SPLIT_RULE", "PolygonSplit", "PolygonMesh", "polygon_split",
            "split_polygons", "read_polygon_mesh"]
@@ -124,7 +125,7 @@ def polygon_split(sizes: Any) -> PolygonSplit:
     return PolygonSplit({int(a): int(b) for a, b in zip(k, n)})
 
 
-def split_polygons(I: Any, C: Any) -> tuple[np.ndarray, np.ndarray, PolygonSplit]:
+def split_polygons(I: Any, C: Any) -> tuple[NDArray[np.int64], NDArray[np.int64], PolygonSplit]:
     """Triangles of a polygon mesh: the fan from each polygon's first corner.
 
     Parameters
@@ -176,9 +177,9 @@ class PolygonMesh:
     messages : list of str, what was dropped or merged while reading
     """
 
-    V: np.ndarray
-    I: np.ndarray
-    C: np.ndarray
+    V: NDArray[np.float64]
+    I: NDArray[np.int64]
+    C: NDArray[np.int64]
     point_data: dict = field(default_factory=dict)
     cell_data: dict = field(default_factory=dict)
     reader: str = ""

@@ -1377,7 +1377,8 @@ def _frame(ps, bounds, width, height, margin=0.04, top_px=0, left_px=0):
     return (float(target[0]), float(target[1])), wpp
 
 
-def screenshot(path, registration=None, *, size=(1024, 768), annotate=True) -> str:
+def screenshot(path: str | os.PathLike, registration: Any = None, *, size: tuple[int, int] = (1024, 768),
+               annotate: bool = True) -> str:
     """Render headless (EGL, unless an interactive backend is running) and save a PNG.
 
     Parameters
