@@ -196,7 +196,7 @@ def test_our_vtk_files_round_trip(result_files, reader):
     if reader == "pyvista":
         require_test_extra("pyvista")
     else:
-        pytest.importorskip("meshio")
+        require_test_extra("meshio")
     V, F, out = result_files
     for (per, ext), (path, est) in out.items():
         if reader == "meshio" and ext == ".vtp":
@@ -217,7 +217,7 @@ def test_our_vtk_files_round_trip(result_files, reader):
 
 
 def test_gltf_glb_and_3mf(tmp_path, capsys):
-    trimesh = pytest.importorskip("trimesh")
+    trimesh = require_test_extra("trimesh")
     from igl_hhj.surfaces import icosphere
     V, F = icosphere(2)
     # every face with its own corners, as glTF exporters write seams: welded back
@@ -236,7 +236,7 @@ def test_gltf_glb_and_3mf(tmp_path, capsys):
         np.testing.assert_array_equal(V2[F2], mf.V[F])                    # same triangles
         assert cli.main(["info", str(seams)]) == 0
         assert "genus             0" in capsys.readouterr().out
-    pytest.importorskip("lxml")                      # trimesh's 3MF reader and writer need lxml
+    require_test_extra("lxml")                       # trimesh's 3MF reader and writer need lxml
     path = tmp_path / "s.3mf"
     trimesh.Trimesh(V, F, process=False).export(path)
     mf = mesh_io.read_mesh_file(path)
@@ -284,3 +284,48 @@ def test_foreign_files_without_polygons_are_clear_errors(tmp_path):
     (tmp_path / "bad.vtp").write_text("<VTKFile")
     with pytest.raises(mesh_io.MeshFileError, match="bad.vtp: (could not read it|no polygons)"):
         mesh_io.read_mesh(tmp_path / "bad.vtp")
+
+
+def _walker_torus_quads(n):
+    """Walker's torus as 2n × n quads of a non-uniform parameter grid (every corner exactly
+    on the surface; the same warp on every level)."""
+    from igl_hhj.surfaces.exact import WalkerTorus
+    a = 2 * np.pi * np.arange(2 * n) / (2 * n)
+    b = 2 * np.pi * np.arange(n) / n
+    T, P = np.meshgrid(b + 0.35 * np.sin(b), a + 0.25 * np.sin(a), indexing="ij")
+    V = WalkerTorus().parametrize(T.ravel(), P.ravel())
+    i, j = np.meshgrid(np.arange(n), np.arange(2 * n), indexing="ij")
+    idx = lambda p, q: (p % n) * (2 * n) + (q % (2 * n))               # noqa: E731
+    Q = np.column_stack([idx(i, j).ravel(), idx(i, j + 1).ravel(), idx(i + 1, j + 1).ravel(),
+                         idx(i + 1, j).ravel()])
+    return V, Q
+
+
+@pytest.mark.parametrize("ext", [".ply", ".vtp"])
+def test_curvature_of_quad_files_converges(tmp_path, ext):
+    """Quad meshes read from files (binary PLY: numpy; VTP: pyvista) and split by the fan
+    rule give HHJ vertex curvatures that converge to Walker's torus at the drop-in's rate
+    (EOC >= 0.9 on the finest pair, as tests/test_curvature.py asks of triangle meshes)."""
+    import igl_hhj
+    from igl_hhj.convergence import eoc, vertex_errors
+    from igl_hhj.surfaces.exact import WalkerTorus
+    errs = []
+    for n in (8, 16, 32, 64):
+        V, Q = _walker_torus_quads(n)
+        path = tmp_path / f"torus{n}{ext}"
+        if ext == ".ply":
+            _write_ply_binary(path, V, Q)
+        else:
+            pv = require_test_extra("pyvista")
+            pv.PolyData(V, np.column_stack([np.full(len(Q), 4), Q]).ravel()).save(path)
+        mf = mesh_io.read_mesh_file(path)
+        assert mf.split.corners == {4: len(Q)}
+        np.testing.assert_array_equal(mf.F, _fan(Q.tolist()))
+        _, _, PV1, PV2, bad = igl_hhj.principal_curvature(mf.V, mf.F)
+        assert bad == []
+        errs.append(vertex_errors(mf.V, mf.F, PV1, PV2, WalkerTorus()))
+    hs = [e["h"] for e in errs]
+    for key in ("k1", "k2", "H", "K", "k_inf"):
+        r = eoc([e[key] for e in errs], hs)
+        assert r[-1] >= 0.9, f"{ext} vertex {key}: EOCs {np.round(r, 3)}"
+    assert errs[-1]["k_inf"] < errs[0]["k_inf"] / 8

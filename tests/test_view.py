@@ -50,8 +50,7 @@ def mock():
 
 
 def test_every_result_reopens_with_its_stored_quantities(mock, results):
-    if any(ext == ".vtp" for _, _, ext in results):
-        require_test_extra("pyvista")                 # .vtp is read with pyvista
+    require_test_extra("pyvista")                     # .vtp is read with pyvista
     for (method, per, ext), (path, quantity, ref) in results.items():
         reg = viewer.register_result(path)
         where = "vertices" if per == "vertex" else "faces"
