@@ -690,6 +690,8 @@ def _failure(exc):
     from .errors import install_hint, missing_optional
     package = missing_optional(exc)
     if package is not None:
+        if "pip install" in str(exc):                 # the message already says what needs it (mesh_io)
+            return EXIT_USAGE, _one_line(exc)
         return EXIT_USAGE, f"this needs the optional '{package}' package: {install_hint(package)}"
     if isinstance(exc, (SolverError, np.linalg.LinAlgError)):
         return EXIT_SOLVER, (f"the solver failed: {_one_line(exc)} (check the mesh with "

@@ -31,6 +31,15 @@ against the lines that follow.  It reads with libigl's C++ messages captured
 and raises :class:`MeshFileError` (a ``ValueError``) with one line naming the
 problem.
 
+The formats libigl lacks (``.gltf .glb .3mf .vtp .vtu .vtk``) and PLYs of quads or
+other polygons (libigl's reader aborts on them) are read by :mod:`igl_hhj.polygon_io`
+(optional trimesh / pyvista / meshio) and by a numpy PLY reader; every format splits
+polygons by one rule, the fan from each polygon's first corner (what libigl's OBJ / OFF
+readers do).  :func:`read_mesh_file` returns the counts (:class:`MeshFile`).
+
+:func:`read_curvature` reads a result back (``.npz``, ``.ply``, ``.vtp``, ``.vtu``,
+``.vtk``; ``igl-hhj view``).
+
 :func:`write_curvature` writes a
 :class:`igl_hhj.baselines.CurvatureEstimate` as ``.npz``, ``.csv``, ``.ply``
 (with MeshLab's ``quality``), ``.vtp`` / ``.vtu`` / ``.vtk``
