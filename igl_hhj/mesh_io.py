@@ -900,7 +900,7 @@ def _read_polygon_ply(path, head, sizes):
         L = _Lines(path, body_start, comments=False, first_line=n_head + 1)
         with open(path, "rb") as fh:
             fh.seek(body_start)
-            body = fh.read(int(L.offset[nV + len(sizes) - 1] - body_start) + (1 << 16))
+            body = fh.read()
         cut = int(L.offset[nV] - body_start) if len(L) > nV else len(body)
         V = np.fromstring(body[:cut], sep=" ").reshape(nV, len(vprops))[:, xyz]
         end = int(L.offset[nV + len(sizes)] - body_start) if len(L) > nV + len(sizes) else len(body)
