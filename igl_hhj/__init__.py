@@ -38,7 +38,7 @@ __version__ = "0.1.0"
 _LAZY_MODULES = {"regge", "biharmonic", "baselines", "viewer", "surfaces", "benchmarks",
                  "hhj", "mesh", "convergence", "cli", "mesh_io", "mesh_report",
                  "curvature", "errors", "interop", "demos",
-                 "recovery", "boundary_estimation", "repair"}
+                 "recovery", "boundary_estimation", "repair", "vtk_files", "polygon_io", "batch"}
 # The core names resolve on first use too, so that ``import igl_hhj`` (and the
 # ``igl-hhj`` command's start-up, where Ctrl-C must not print a traceback) costs
 # no numpy/scipy import.
@@ -63,9 +63,9 @@ if TYPE_CHECKING:
     # at run time nothing here is imported and ``__getattr__`` below resolves the
     # names on first use.  Keep in step with _LAZY_MODULES / _LAZY_ATTRS
     # (tests/test_typing.py checks that the two agree).
-    from . import (baselines, benchmarks, biharmonic, boundary_estimation, cli, convergence, curvature,
-                   demos, errors, hhj, interop, mesh, mesh_io, mesh_report, recovery, regge, repair,
-                   surfaces, viewer)
+    from . import (baselines, batch, benchmarks, biharmonic, boundary_estimation, cli, convergence, curvature,
+                   demos, errors, hhj, interop, mesh, mesh_io, mesh_report, polygon_io, recovery, regge,
+                   repair, surfaces, viewer, vtk_files)
     from .biharmonic import BiharmonicSolver, biharmonic_solve
     from .curvature import (boundary_treatment, curvature_of, face_gaussian_curvature,
                             face_mean_curvature, face_principal_curvature, principal_curvature,

@@ -44,8 +44,10 @@ open meshes it runs but its boundary values are wrong.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 import scipy.sparse as sp
 
 from .curvature import check_principal_curvature_args, vertex_principal_curvature
@@ -86,13 +88,13 @@ class CurvatureEstimate:
     """
 
     location: str
-    k1: np.ndarray
-    k2: np.ndarray
-    H: np.ndarray
-    K: np.ndarray
-    d1: np.ndarray | None
-    d2: np.ndarray | None
-    bad: np.ndarray
+    k1: NDArray[np.float64]
+    k2: NDArray[np.float64]
+    H: NDArray[np.float64]
+    K: NDArray[np.float64]
+    d1: NDArray[np.float64] | None
+    d2: NDArray[np.float64] | None
+    bad: NDArray[np.int64]
     name: str = ""
 
 
@@ -128,7 +130,8 @@ def _given_shape_operator(mesh, S, kwargs):
     return S
 
 
-def hhj_vertex(V, F=None, *, shape_operator=None, radius=5, **kwargs):
+def hhj_vertex(V: Any, F: Any = None, *, shape_operator: Any = None, radius: int = 5,
+               **kwargs: Any) -> CurvatureEstimate:
     """HHJ drop-in at the vertices (:func:`igl_hhj.curvature.principal_curvature`).
 
     Parameters
@@ -152,7 +155,8 @@ def hhj_vertex(V, F=None, *, shape_operator=None, radius=5, **kwargs):
     return _ordered("hhj_vertex", "vertex", PV1, PV2, 0.5 * (PV1 + PV2), PV1 * PV2, PD1, PD2, bad)
 
 
-def hhj_face(V, F=None, *, shape_operator=None, smoothing=0, **kwargs):
+def hhj_face(V: Any, F: Any = None, *, shape_operator: Any = None, smoothing: float = 0,
+             **kwargs: Any) -> CurvatureEstimate:
     """Walker's HHJ shape operator S_h per face (eq. 5.12/5.14).
 
     Parameters
@@ -182,7 +186,7 @@ def hhj_face(V, F=None, *, shape_operator=None, smoothing=0, **kwargs):
 
 
 # --------------------------------------------------------------------------- libigl
-def libigl_quadric(V, F, radius=5, useKring=True):
+def libigl_quadric(V: Any, F: Any, radius: int = 5, useKring: bool = True) -> CurvatureEstimate:
     """``igl.principal_curvature`` (quadric fitting, Panozzo–Puppo–Rocca 2010).
 
     Parameters
@@ -288,7 +292,7 @@ def angle_defect_gaussian_curvature(V, F):
     return K
 
 
-def libigl_cotan(V, F):
+def libigl_cotan(V: Any, F: Any) -> CurvatureEstimate:
     """Cotangent mean curvature + angle-defect Gauss curvature, principal values from them.
 
     Returns
@@ -395,7 +399,7 @@ def heine_weingarten_map(V, F):
     return Pi, nu, Y
 
 
-def heine(V, F):
+def heine(V: Any, F: Any) -> CurvatureEstimate:
     """Heine's P1 estimator as a :class:`CurvatureEstimate` (location "vertex").
 
     ``H = tr(Π_h)/2`` and ``K = ((tr Π_h)² - tr(Π_h²))/2`` (the sum of the 2×2
@@ -424,7 +428,7 @@ PYMESHLAB_METHODS = {
 }
 
 
-def pymeshlab_principal_curvature(V, F, method="quadric"):
+def pymeshlab_principal_curvature(V: Any, F: Any, method: str = "quadric") -> CurvatureEstimate:
     """MeshLab's per-vertex principal curvatures (optional peer; ``pip install pymeshlab``).
 
     Runs ``compute_curvature_principal_directions_per_vertex`` twice (the
@@ -522,7 +526,7 @@ ESTIMATORS = {
 entries raise ImportError without pymeshlab."""
 
 
-def estimate(name, V, F):
+def estimate(name: str, V: Any, F: Any) -> CurvatureEstimate:
     """Run the estimator ``name`` of :data:`ESTIMATORS` on ``(V, F)``."""
     if name not in ESTIMATORS:
         raise ValueError(f"unknown estimator {name!r}; use one of {sorted(ESTIMATORS)}")

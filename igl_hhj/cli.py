@@ -10,6 +10,9 @@ Commands
     principal curvatures and directions, mean and Gauss curvature of a mesh
     file, written to ``.npz``, ``.csv``, ``.ply``, ``.vtp``, ``.vtu``, ``.vtk`` or
     ``.obj``; optional polyscope view or screenshot.
+``igl-hhj view RESULT``
+    re-open a saved result (``curvature -o`` ``.npz``, ``.ply``, ``.vtp``, ``.vtu``,
+    ``.vtk``) with its stored quantities in the viewer, or ``--screenshot PNG``.
 ``igl-hhj info MESH``
     what the mesh is made of, whether igl_hhj accepts it, and which repairs the
     drop-in ``principal_curvature`` would make to a refused one.
@@ -107,16 +110,18 @@ class _Stages:
 
 
 def _read(path):
-    """Guarded read; libigl's warnings become one warning line."""
-    from .mesh_io import MeshFileError, read_mesh
+    """Guarded read (:func:`igl_hhj.mesh_io.read_mesh_file`); the reader's warnings become
+    one warning line.  Polygons split into triangles are not a warning: the callers say so."""
+    from .mesh_io import MeshFileError, read_mesh_file
     try:
-        V, F, messages = read_mesh(path)
+        mf = read_mesh_file(path)
     except MeshFileError as exc:
         raise UserError(str(exc), EXIT_UNREADABLE) from None
+    messages = mf.messages
     if messages:
         more = f" (+{len(messages) - 2} more)" if len(messages) > 2 else ""
         print(f"igl-hhj: warning: {path}: " + "; ".join(messages[:2]) + more, file=sys.stderr)
-    return V, F
+    return mf
 
 
 def _check_writable(path, extensions=None):
@@ -269,7 +274,8 @@ def _curvature(args):
             raise UserError(f"--size must be at least 16 16 pixels, got {args.size[0]} {args.size[1]}")
 
     t = time.perf_counter()
-    V, F = _read(args.mesh)
+    mf = _read(args.mesh)
+    V, F = mf.V, mf.F
     try:
         mesh = TriangleMesh(V, F)
     except (ValueError, TypeError) as exc:
@@ -293,6 +299,8 @@ def _curvature(args):
 
     say(f"{args.mesh}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, "
           f"{int(mesh.boundary_edges.sum())} boundary edges")
+    if mf.split.n_split:
+        say(f"  {mf.split.describe()}")
     say(f"  method {args.method} per {per}: {dt:.2f} s")
     if args.method == "hhj":
         say(f"  smoothing scale (--radius): {radius}" + (" (none: Walker's S_h per face)" if radius == 0 else ""))
@@ -414,11 +422,51 @@ def _batch(args):
     return 0 if c["error"] + c["timeout"] == 0 else 1
 
 
+# --------------------------------------------------------------------------- view
+def _view(args):
+    """Re-open a saved result (:func:`igl_hhj.viewer.register_result`): the window, or
+    ``--screenshot`` headless."""
+    from .mesh_io import MeshFileError, read_curvature
+    say = _say(args)
+    if not 0 <= args.robust < 50:
+        raise UserError(f"--robust must be a percentile in [0, 50), got {args.robust}")
+    if args.screenshot is not None:
+        _check_writable(args.screenshot, (".png",))
+        if min(args.size) < 16:
+            raise UserError(f"--size must be at least 16 16 pixels, got {args.size[0]} {args.size[1]}")
+    try:
+        cf = read_curvature(args.result)               # read once here for the errors and the summary
+    except MeshFileError as exc:
+        raise UserError(str(exc), EXIT_UNREADABLE) from None
+    est = cf.estimate
+    stored = ["k1", "k2", "H", "K"] + (["d1", "d2"] if est.d1 is not None else []) + (["S"] if cf.S is not None else [])
+    say(f"{args.result}: {len(cf.V)} vertices, {len(cf.F)} faces; {', '.join(stored)} per {est.location}"
+        + (f" (method {cf.method})" if cf.method else ""))
+    viewer = _viewer()
+    shown = dict(enabled=args.quantity, robust=args.robust if args.robust > 0 else None,
+                 view=args.camera, show_directions=args.directions)
+    if args.screenshot is None:
+        try:
+            viewer.register_result(args.result, **shown)
+            viewer.show()
+        except viewer.ViewerUnavailable as exc:
+            raise UserError(f"cannot open the viewer window: {_first_line(exc)} "
+                            f"(without a display use --screenshot PNG)") from None
+        return 0
+    try:
+        _quietly(viewer.register_result, args.result, screenshot=str(args.screenshot),
+                 size=tuple(args.size), **shown)
+    except viewer.ViewerUnavailable as exc:
+        raise UserError(f"no screenshot: {_with_hint(exc)}") from None
+    say(f"  wrote {args.screenshot}")
+    return 0
+
+
 # --------------------------------------------------------------------------- info
 def _info(args):
     from .mesh_report import mesh_report
-    V, F = _read(args.mesh)
-    report = mesh_report(V, F)
+    mf = _read(args.mesh)
+    report = mesh_report(mf.V, mf.F, split=mf.split)
     print(f"{args.mesh}")
     for line in report.lines():
         print(f"  {line}")
@@ -502,10 +550,13 @@ def build_parser():
                    help="screenshot size in pixels (default 1600 700)")
     d.set_defaults(func=_demo)
 
-    c = sub.add_parser("curvature", help="curvature of a mesh file (any format libigl reads)",
+    c = sub.add_parser("curvature", help="curvature of a mesh file (libigl's formats, glTF, 3MF, VTK)",
                        description="Principal curvatures k1 >= k2, directions d1, d2, mean H and "
                                    "Gauss K curvature of a triangle mesh (.obj .off .ply .stl .wrl "
-                                   ".mesh .msh). Sign: +1/R on a sphere with outward normals.")
+                                   ".mesh .msh with libigl; .gltf .glb .3mf with trimesh, .vtp .vtu "
+                                   ".vtk with pyvista or meshio). Polygons are split into triangles "
+                                   "(fan from each polygon's first corner). Sign: +1/R on a sphere "
+                                   "with outward normals.")
     c.add_argument("mesh", metavar="MESH")
     c.add_argument("--method", choices=["hhj", "igl", "heine"], default="hhj",
                    help="hhj: Walker's HHJ shape operator (default); igl: igl.principal_curvature "
@@ -578,6 +629,27 @@ def build_parser():
     b.add_argument("-q", "--quiet", action="store_true", help="no progress bar / lines")
     b.set_defaults(func=_batch)
 
+    from .mesh_io import RESULT_EXTENSIONS
+    v = sub.add_parser("view", help="re-open a saved result (curvature -o) in the viewer or as a screenshot",
+                       description="Show the curvature stored in RESULT (written by 'igl-hhj curvature "
+                                   f"-o': {' '.join(RESULT_EXTENSIONS)}) in the polyscope viewer: k1, k2, "
+                                   "H, K per vertex or per face and the principal directions d1, d2 "
+                                   "when stored; --screenshot renders headless instead.")
+    v.add_argument("result", metavar="RESULT")
+    v.add_argument("--screenshot", metavar="PNG", help="render headless to PNG instead of opening a window")
+    v.add_argument("--quantity", choices=["k1", "k2", "H", "K"], default=None,
+                   help="quantity shown first (default: the one the file was written to show: "
+                        "the .ply quality, the VTK active scalars; else H)")
+    v.add_argument("--directions", action="store_true", help="show the principal directions too")
+    v.add_argument("--camera", type=_camera, default="auto", metavar="DIR",
+                   help="as for 'igl-hhj curvature' (default auto)")
+    v.add_argument("--size", type=int, nargs=2, default=(1024, 768), metavar=("W", "H"),
+                   help="--screenshot size in pixels (default 1024 768)")
+    v.add_argument("--robust", type=float, default=1.0, metavar="P",
+                   help="colour range from the P-th to the (100-P)-th percentile (default 1; 0: full range)")
+    v.add_argument("-q", "--quiet", action="store_true", help="print nothing but warnings and errors")
+    v.set_defaults(func=_view)
+
     i = sub.add_parser("info", help="mesh statistics and whether igl_hhj accepts the mesh",
                        description="Vertices, faces, edges, components, boundary loops, Euler "
                                    "characteristic, genus, manifoldness, orientation, degenerate and "
@@ -618,6 +690,8 @@ def _failure(exc):
     from .errors import install_hint, missing_optional
     package = missing_optional(exc)
     if package is not None:
+        if "pip install" in str(exc):                 # the message already says what needs it (mesh_io)
+            return EXIT_USAGE, _one_line(exc)
         return EXIT_USAGE, f"this needs the optional '{package}' package: {install_hint(package)}"
     if isinstance(exc, (SolverError, np.linalg.LinAlgError)):
         return EXIT_SOLVER, (f"the solver failed: {_one_line(exc)} (check the mesh with "

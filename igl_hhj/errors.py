@@ -26,8 +26,9 @@ OPTIONAL_PACKAGES = {
     "dask": ("dask[distributed]", "distributed"),
     "distributed": ("dask[distributed]", "distributed"),
     "pyarrow": ("pyarrow", "test"),
-    "trimesh": ("trimesh", "test"),
-    "pyvista": ("pyvista", "test"),
+    "trimesh": ("trimesh", "io"),
+    "pyvista": ("pyvista", "io"),
+    "lxml": ("lxml", "io"),
     "tqdm": ("tqdm", "benchmark"),
     "pymeshlab": ("pymeshlab", "benchmark"),
 }

@@ -31,6 +31,15 @@ against the lines that follow.  It reads with libigl's C++ messages captured
 and raises :class:`MeshFileError` (a ``ValueError``) with one line naming the
 problem.
 
+The formats libigl lacks (``.gltf .glb .3mf .vtp .vtu .vtk``) and PLYs of quads or
+other polygons (libigl's reader aborts on them) are read by :mod:`igl_hhj.polygon_io`
+(optional trimesh / pyvista / meshio) and by a numpy PLY reader; every format splits
+polygons by one rule, the fan from each polygon's first corner (what libigl's OBJ / OFF
+readers do).  :func:`read_mesh_file` returns the counts (:class:`MeshFile`).
+
+:func:`read_curvature` reads a result back (``.npz``, ``.ply``, ``.vtp``, ``.vtu``,
+``.vtk``; ``igl-hhj view``).
+
 :func:`write_curvature` writes a
 :class:`igl_hhj.baselines.CurvatureEstimate` as ``.npz``, ``.csv``, ``.ply``
 (with MeshLab's ``quality``), ``.vtp`` / ``.vtu`` / ``.vtk``
@@ -44,19 +53,31 @@ from __future__ import annotations
 import os
 import re
 import tempfile
+from dataclasses import dataclass, field
 from pathlib import Path
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import NDArray
 
-__all__ = ["MeshFileError", "CapturedOutput", "MESH_EXTENSIONS", "OUTPUT_EXTENSIONS", "read_mesh",
-           "check_output_path", "probe_writable", "write_curvature", "CURVATURE_COLUMNS", "MESHIO_EXTENSIONS",
+from .polygon_io import EXTRA_EXTENSIONS, PolygonSplit, polygon_split, read_polygon_mesh, split_polygons
+
+if TYPE_CHECKING:
+    from .baselines import CurvatureEstimate
+
+__all__ = ["MeshFileError", "MeshFile", "read_mesh_file", "READ_EXTENSIONS", "CapturedOutput", "MESH_EXTENSIONS", "OUTPUT_EXTENSIONS", "read_mesh",
+           "check_output_path", "probe_writable", "write_curvature", "read_curvature", "CurvatureFile",
+           "RESULT_EXTENSIONS", "CURVATURE_COLUMNS", "MESHIO_EXTENSIONS",
            "VTK_EXTENSIONS",
            "quantity_colours"]
 
 MESH_EXTENSIONS = (".obj", ".off", ".ply", ".stl", ".wrl", ".mesh", ".msh")
 """Extensions ``igl.read_triangle_mesh`` dispatches on (case-insensitive)."""
+
+READ_EXTENSIONS = MESH_EXTENSIONS + tuple(EXTRA_EXTENSIONS)
+"""Extensions :func:`read_mesh` reads: libigl's, and through optional packages those of
+:data:`igl_hhj.polygon_io.EXTRA_EXTENSIONS` (glTF/GLB, 3MF, VTP, VTU, VTK)."""
 
 OUTPUT_EXTENSIONS = (".npz", ".csv", ".ply", ".vtp", ".vtu", ".vtk", ".obj")
 VTK_EXTENSIONS = (".vtp", ".vtu", ".vtk")
@@ -89,9 +110,10 @@ def _check_input_file(path):
     if not path.is_file():
         raise MeshFileError(f"{path}: not a regular file")
     ext = path.suffix.lower()
-    if ext not in MESH_EXTENSIONS:
+    if ext not in READ_EXTENSIONS:
         raise MeshFileError(f"{path}: unknown mesh file extension {path.suffix!r} "
-                            f"(libigl reads {', '.join(MESH_EXTENSIONS)})")
+                            f"(libigl reads {', '.join(MESH_EXTENSIONS)}; with trimesh, pyvista or "
+                            f"meshio also {', '.join(EXTRA_EXTENSIONS)})")
     try:
         with open(path, "rb") as fh:
             head = fh.read(_HEADER_BYTES)
@@ -269,7 +291,8 @@ def _first_bad(path, lines, bad, what):
 
 def _check_off_body(path, nV, nF):
     """Every vertex line numeric, every face line a polygon whose corner count its
-    indices back up (libigl allocates whatever a face line claims)."""
+    indices back up (libigl allocates whatever a face line claims).  Returns the
+    corner count of every face ((nF,) int64)."""
     L = _Lines(path, 0)
     h = 1 if L.ntok[0] >= 3 else 2                 # counts on the OFF line or the next one
     if len(L) < h + nV + nF:
@@ -289,7 +312,8 @@ def _check_off_body(path, nV, nF):
     _check_rows(path, L, f, k < 3, "face with fewer than 3 corners")
     _check_rows(path, L, f, L.int_k[f] != k, "face corner is not a non-negative integer index")
     if wrapped.size:
-        _check_off_wrapped_faces(path, L, w, nF - int(wrapped[0]))
+        k = np.concatenate([k, _check_off_wrapped_faces(path, L, w, nF - int(wrapped[0]))])
+    return k
 
 
 def _line_tokens(fh, L, i):
@@ -303,12 +327,13 @@ def _check_off_wrapped_faces(path, L, start, n):
     corner count, then that many indices over as many lines as they take (the rest of the
     line of the last index is ignored).  Only reached when some record wraps a line."""
     with open(path, "rb") as fh:
-        _wrapped_faces(path, fh, L, start, n)
+        return _wrapped_faces(path, fh, L, start, n)
 
 
 def _wrapped_faces(path, fh, L, start, n):
     i = start
-    for _ in range(n):
+    sizes = np.zeros(n, dtype=np.int64)
+    for r in range(n):
         if i >= len(L):
             raise MeshFileError(f"{path}: truncated: the file ends before its last face records")
         line = i
@@ -317,6 +342,7 @@ def _wrapped_faces(path, fh, L, start, n):
         k = int(L.first[i])
         if k < 3:
             _first_bad(path, L, np.arange(len(L)) == i, "face with fewer than 3 corners")
+        sizes[r] = k
         need = k
         toks = _line_tokens(fh, L, i)[1:]
         while True:
@@ -338,6 +364,7 @@ def _wrapped_faces(path, fh, L, start, n):
                 _first_bad(path, L, np.arange(len(L)) == line,
                            "comment inside a face record that continues on the next line")
         i += 1
+    return sizes
 
 
 def _check_rows(path, L, rows, bad, what):
@@ -348,7 +375,8 @@ def _check_rows(path, L, rows, bad, what):
 
 
 def _check_obj(path):
-    """``v`` lines numeric, ``f`` lines made of corner indices, and 1-based."""
+    """``v`` lines numeric, ``f`` lines made of corner indices, and 1-based.  Returns the
+    corner count of every face ((#f lines,) int64)."""
     L = _Lines(path, 0, corners=True)
     one = L.flen == 1
     v = one & (L.c0 == ord("v"))
@@ -365,6 +393,7 @@ def _check_obj(path):
         _first_bad(path, L, bad, "face uses vertex index 0, but OBJ indices start at 1: the file "
                                  "is 0-based (add 1 to every face index, or write it with a "
                                  "1-based OBJ writer)")
+    return (L.ntok - 1)[f]
 
 
 def _check_stl(path, head, size):
@@ -417,7 +446,7 @@ def _check_off_header(path, head, size):
     lines = [ln.split(b"#")[0].split() for ln in head.split(b"\n")[:64]]
     tokens = [t for ln in lines for t in ln]
     if not tokens or not re.fullmatch(rb"[A-Z]*OFF", tokens[0]):
-        return                                               # libigl reports this itself
+        return None                                          # libigl reports this itself
     if b"BINARY" in tokens[:2]:
         raise MeshFileError(f"{path}: binary OFF is not supported by libigl's reader")
     try:
@@ -431,7 +460,7 @@ def _check_off_header(path, head, size):
     need = 6 * nV + 8 * nF - 1          # "0 0 0\n" per vertex, "3 0 1 2\n" per face
     if need > size:
         _too_short(path, f"{nV} vertices and {nF} faces", need, size)
-    _check_off_body(path, nV, nF)
+    return _check_off_body(path, nV, nF)
 
 
 def _ply_head(path, head):
@@ -528,7 +557,10 @@ def _check_ply_property_groups(path, named):
 
 
 def _check_ply(path, head, size):
-    """PLY element counts against the body, and triangles only (libigl aborts on mixed polygons)."""
+    """PLY element counts against the body.  Returns None for a triangle mesh, else the corner
+    count of every face ((#faces,) int64: polygons, which libigl's reader aborts on, so
+    :func:`read_mesh_file` reads them with pyvista); a binary PLY may hold triangles or
+    k-gons of one k, an ascii PLY any polygons."""
     fmt, elements, body_start = _parse_ply_header(path, head)
     body = size - body_start
     counts = {name: n for name, n, _ in elements}
@@ -547,14 +579,24 @@ def _check_ply(path, head, size):
                 else:
                     rec += _PLY_SIZES.get(types[0], 1)
             need += n * rec
+        corners = 3
+        if exact and need < body and counts.get("face", 0):
+            # k-gons of one k: (k - 3) more indices per face record
+            index = next(_PLY_SIZES.get(t[2], 4) for p, t in dict(_ply_element_props(elements))["face"]
+                         if t[0] == "list")
+            extra, per = body - need, counts["face"] * index
+            if extra % per == 0:
+                corners = 3 + extra // per
+                need = body
         if need > body or (exact and need != body):
             raise MeshFileError(
                 f"{path}: truncated or not a triangle mesh: the header declares {what}, "
                 f"a triangle mesh with those needs {need} body bytes, the file has {body} "
-                f"(libigl's PLY reader crashes or returns garbage on such files)")
+                f"(libigl's PLY reader crashes or returns garbage on such files; binary PLYs "
+                f"of mixed polygons are not supported: store them as ascii PLY, OBJ or OFF)")
         if exact:
-            _check_binary_ply_faces(path, fmt, elements, body_start)
-        return
+            _check_binary_ply_faces(path, fmt, elements, body_start, corners)
+        return None if corners == 3 else np.full(counts.get("face", 0), corners, dtype=np.int64)
     # ascii: one line per element; check the count first (bounded memory), then the lines
     total = sum(counts.values())
     if 2 * total - 1 > body:
@@ -568,32 +610,39 @@ def _check_ply(path, head, size):
                             f"(libigl's PLY reader aborts on such files)")
     if (L.n_num != L.ntok).any():
         _first_bad(path, L, L.n_num != L.ntok, "non-numeric value in the body of an ascii PLY")
-    start = 0
+    start, sizes = 0, None
     for name, n, props in elements:
         rows = slice(start, start + n)
         lists = [p for p, types in props if types[0] == "list"]
         if name == "face" and n:
             k = L.first[rows]
-            _check_rows(path, L, rows, k != 3, "face is not a triangle (only triangle meshes are "
-                        "supported: libigl's PLY reader aborts on mixed polygons)")
+            _check_rows(path, L, rows, k < 3, "face line does not start with a corner count of 3 or more")
+            sizes = k
             # an index of 10 or more digits is beyond any vertex count a PLY header can
             # declare here, and from 2³¹ on libigl's reader overflows and aborts
             _check_rows(path, L, rows, L.maxlen[rows] >= 10,
                         f"face line has a vertex index of 10 or more digits (the header declares "
                         f"{counts.get('vertex', 0)} vertices)")
             if lists == [p for p, _ in props if p in ("vertex_indices", "vertex_index")]:
-                want = 1 + 3 + (len(props) - len(lists))
+                want = 1 + k + (len(props) - len(lists))
                 _check_rows(path, L, rows, L.ntok[rows] != want,
-                            f"face line does not have the {want} values its properties need")
+                            "face line does not have the values its properties need (its corner "
+                            "count, that many indices, one value per other property)")
         elif not lists and n:
             _check_rows(path, L, rows, L.ntok[rows] != len(props),
                         f"{name} line does not have the {len(props)} values its properties need")
         start += n
+    return None if sizes is None or (sizes == 3).all() else sizes
 
 
-def _check_binary_ply_faces(path, fmt, elements, body_start):
-    """Every face record of a binary PLY of known layout must be a triangle (a corrupt
-    count makes libigl read indices out of the following records)."""
+def _ply_element_props(elements):
+    """[(element name, its properties)] of a parsed PLY header."""
+    return [(name, props) for name, _, props in elements]
+
+
+def _check_binary_ply_faces(path, fmt, elements, body_start, corners=3):
+    """Every face record of a binary PLY of known layout must have ``corners`` corners (a
+    corrupt count makes libigl read indices out of the following records)."""
     order = "<" if fmt == "binary_little_endian" else ">"
     kinds = {1: "u1", 2: "u2", 4: "u4", 8: "u8"}
     offset = body_start
@@ -605,7 +654,7 @@ def _check_binary_ply_faces(path, fmt, elements, body_start):
                     ok = False
                     break
                 fields.append(("count", order + kinds.get(_PLY_SIZES.get(types[1], 1), "u1")))
-                fields.append((f"i{k}", order + kinds.get(_PLY_SIZES.get(types[2], 4), "u4"), (3,)))
+                fields.append((f"i{k}", order + kinds.get(_PLY_SIZES.get(types[2], 4), "u4"), (corners,)))
             else:
                 fields.append((f"p{k}", f"V{_PLY_SIZES.get(types[0], 1)}"))
         if not ok:
@@ -613,11 +662,12 @@ def _check_binary_ply_faces(path, fmt, elements, body_start):
         dt = np.dtype(fields)
         if name == "face" and n and "count" in dt.names:
             rec = np.fromfile(path, dtype=dt, count=n, offset=offset)
-            bad = np.flatnonzero(rec["count"] != 3)
+            bad = np.flatnonzero(rec["count"] != corners)
             if bad.size:
                 raise MeshFileError(f"{path}: face {int(bad[0])} declares {int(rec['count'][bad[0]])} "
-                                    f"corners: corrupt, or not a triangle mesh (only triangle "
-                                    f"meshes are supported)")
+                                    f"corners where the file size says {corners}: corrupt, or "
+                                    f"mixed polygons (binary PLYs must hold faces of one corner "
+                                    f"count)")
         offset += n * dt.itemsize
 
 
@@ -670,22 +720,63 @@ def _libigl_says(lines):
     return f" (libigl: {first})"
 
 
-def read_mesh(path):
-    """Read a triangle mesh with ``igl.read_triangle_mesh``, guarded.
+@dataclass
+class MeshFile:
+    """A mesh file as :func:`read_mesh_file` read it.
+
+    Attributes
+    ----------
+    V : (#V, 3) float64
+    F : (#F, 3) int64, polygons split into triangles (:func:`igl_hhj.polygon_io.split_polygons`:
+        the fan from each polygon's first corner, the rule of libigl's OBJ / OFF readers)
+    messages : list of str
+        What the reader printed (libigl's warnings, at most 20 lines), cells it
+        ignored, coincident ``.stl`` / glTF vertices it merged.
+    split : PolygonSplit
+        The corner counts of the file's faces (``split.describe()``: "12 quads split into
+        24 triangles"; empty when the file holds triangles only).
+    reader : str
+        ``"libigl"`` or the optional package that read the file.
+    point_data, cell_data : dict name -> array
+        Arrays stored with the mesh (VTK files); ``cell_data`` rows follow ``F`` (a split
+        polygon's row repeated for each of its triangles).
+    active_scalars : str or None, the array a VTK file marks active (read with pyvista)
+    """
+
+    V: NDArray[np.float64]
+    F: NDArray[np.int64]
+    messages: list = field(default_factory=list)
+    split: PolygonSplit = field(default_factory=PolygonSplit)
+    reader: str = "libigl"
+    point_data: dict = field(default_factory=dict)
+    cell_data: dict = field(default_factory=dict)
+    active_scalars: str | None = None
+
+    def notes(self) -> list[str]:
+        """:attr:`messages` plus the split line when polygons were split."""
+        return list(self.messages) + ([self.split.describe()] if self.split.n_split else [])
+
+
+def read_mesh(path: str | os.PathLike) -> tuple[NDArray[np.float64], NDArray[np.int64], list[str]]:
+    """Read a triangle mesh, guarded: libigl's formats with ``igl.read_triangle_mesh``,
+    the others through optional packages (:mod:`igl_hhj.polygon_io`).
 
     Parameters
     ----------
     path : str or os.PathLike
-        A file with one of :data:`MESH_EXTENSIONS`.
+        A file with one of :data:`READ_EXTENSIONS`.
 
     Returns
     -------
     V : (#V, 3) float64
     F : (#F, k) int64 as libigl returns it (k = 3 for triangle meshes; not
-        validated further: use :class:`igl_hhj.mesh.TriangleMesh`).
+        validated further: use :class:`igl_hhj.mesh.TriangleMesh`); polygons split
+        into triangles by one rule for every format (the fan from each polygon's
+        first corner, :func:`igl_hhj.polygon_io.split_polygons`).
     messages : list of str
-        What libigl printed while reading (warnings; at most 20 lines), plus a
-        note when coincident ``.stl`` vertices were merged.
+        What libigl printed while reading (warnings; at most 20 lines), a note when
+        coincident ``.stl`` / glTF vertices were merged, and one when polygons were
+        split ("12 quads split into 24 triangles ...").
 
     Raises
     ------
@@ -693,6 +784,24 @@ def read_mesh(path):
         Missing / unreadable / empty file, a directory, an unknown extension,
         a header that does not match the file, a read failure, or a file from
         which libigl read no faces.
+    ModuleNotFoundError
+        A format libigl lacks and none of the packages that read it is installed (the
+        message names the install command).
+
+    See Also
+    --------
+    read_mesh_file : the same with the split counts, the reader and the stored arrays.
+    """
+    mf = read_mesh_file(path)
+    return mf.V, mf.F, mf.notes()
+
+
+def read_mesh_file(path: str | os.PathLike) -> MeshFile:
+    """Read a mesh file like :func:`read_mesh`, keeping what was split and stored.
+
+    Returns
+    -------
+    MeshFile
     """
     path, ext, head = _check_input_file(path)
     if head.startswith(_BOM) and ext in (".obj", ".off", ".ply"):
@@ -725,12 +834,17 @@ def _read_without_bom(path):
 
 def _read_checked(path, ext, head):
     size = path.stat().st_size
+    sizes = None
+    if ext in EXTRA_EXTENSIONS:
+        return _read_polygons(path, ext)
     if ext == ".off":
-        _check_off_header(path, head, size)
+        sizes = _check_off_header(path, head, size)
     elif ext == ".ply":
-        _check_ply(path, head, size)
+        sizes = _check_ply(path, head, size)
+        if sizes is not None:                        # libigl's PLY reader aborts on polygons
+            return _read_polygon_ply(path, head, sizes)
     elif ext == ".obj":
-        _check_obj(path)
+        sizes = _check_obj(path)
     elif ext == ".stl":
         _check_stl(path, head, size)
     elif ext in (".mesh", ".msh"):
@@ -745,7 +859,7 @@ def _read_checked(path, ext, head):
     if exc is not None:
         raise MeshFileError(f"{path}: libigl could not read it: {exc}{_libigl_says(cap.lines)}")
     V = np.asarray(V, dtype=np.float64)
-    F = np.asarray(F)
+    F = np.asarray(F, dtype=np.int64)
     if F.size == 0:
         raise MeshFileError(f"{path}: libigl read no faces from this {ext} file"
                             f"{_libigl_says(cap.lines)}")
@@ -753,12 +867,95 @@ def _read_checked(path, ext, head):
         raise MeshFileError(f"{path}: vertices are not 3D points (shape {V.shape})")
     messages = list(cap.lines)
     if ext == ".stl" and F.ndim == 2 and F.size and F.min() >= 0 and F.max() < len(V):
-        # STL stores every triangle with its own corners: weld exactly coincident points
-        V, _, J = igl.remove_duplicate_vertices(V, 0.0)
-        nV_before = len(J)
-        F = J[F]
-        messages.append(f"merged coincident STL vertices: {nV_before} -> {len(V)}")
-    return V, F, messages
+        V, F, _ = _weld(V, F, messages, "STL")
+    split = polygon_split(sizes if sizes is not None and int(np.sum(np.asarray(sizes) - 2)) == len(F)
+                          else np.full(len(F), F.shape[1] if F.ndim == 2 else 3))
+    return MeshFile(V, F, messages, split)
+
+
+def _weld(V, F, messages, what):
+    """Merge exactly coincident points (STL, glTF store corners per triangle / per seam)."""
+    import igl
+    V2, _, J = igl.remove_duplicate_vertices(V, 0.0)
+    if len(V2) == len(V):
+        return V, F, np.arange(len(V))
+    messages.append(f"merged coincident {what} vertices: {len(J)} -> {len(V2)}")
+    return V2, J[F], J
+
+
+def _read_polygon_ply(path, head, sizes):
+    """A PLY of polygons (checked by ``_check_ply``), read with numpy: the vertex x, y, z
+    as stored (float64 exactly; VTK's PLY reader would round them to float32) and the
+    faces in file order, split like every other format."""
+    fmt, elements, body_start = _parse_ply_header(path, head)
+    names = [name for name, _, _ in elements]
+    if names[:2] != ["vertex", "face"] or any(t[0] == "list" for _, t in elements[0][2]):
+        return _read_polygons(path, ".ply")                  # an unusual layout: VTK's reader
+    nV, vprops = elements[0][1], [p for p, _ in elements[0][2]]
+    fprops = elements[1][2]
+    xyz = [vprops.index(c) for c in "xyz"]
+    if fmt == "ascii":
+        with open(path, "rb") as fh:
+            n_head = fh.read(body_start).count(b"\n")
+        L = _Lines(path, body_start, comments=False, first_line=n_head + 1)
+        with open(path, "rb") as fh:
+            fh.seek(body_start)
+            body = fh.read()
+        cut = int(L.offset[nV] - body_start) if len(L) > nV else len(body)
+        V = np.fromstring(body[:cut], sep=" ").reshape(nV, len(vprops))[:, xyz]
+        end = int(L.offset[nV + len(sizes)] - body_start) if len(L) > nV + len(sizes) else len(body)
+        flat = np.fromstring(body[cut:end], sep=" ")
+        ntok = L.ntok[nV:nV + len(sizes)]
+        lead = next(j for j, (p, t) in enumerate(fprops) if t[0] == "list")   # values before the list
+        starts = np.concatenate([[0], np.cumsum(ntok)[:-1]]) + lead + 1
+        C = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+        I = flat[np.repeat(starts, sizes) + np.arange(C[-1]) - np.repeat(C[:-1], sizes)].astype(np.int64)
+    else:
+        order = "<" if fmt == "binary_little_endian" else ">"
+        kinds = {1: "i1", 2: "i2", 4: "i4", 8: "i8"}
+        vdt = np.dtype([(p, order + ("f" if t[0] in ("float", "float32", "double", "float64") else
+                                      ("u" if t[0].startswith("u") else "i")) + str(_PLY_SIZES[t[0]]))
+                        for p, t in elements[0][2]])
+        vert = np.fromfile(path, dtype=vdt, count=nV, offset=body_start)
+        V = np.column_stack([vert[c].astype(np.float64) for c in "xyz"])
+        k = int(sizes[0])
+        fields = []
+        for j, (p, t) in enumerate(fprops):
+            if t[0] == "list":
+                fields += [("count", order + kinds[_PLY_SIZES[t[1]]]),
+                           ("index", order + ("u" if t[2].startswith("u") else "i") + str(_PLY_SIZES[t[2]]), (k,))]
+            else:
+                fields.append((f"p{j}", f"V{_PLY_SIZES[t[0]]}"))
+        face = np.fromfile(path, dtype=np.dtype(fields), count=len(sizes), offset=body_start + nV * vdt.itemsize)
+        I = face["index"].astype(np.int64).ravel()
+        C = np.arange(0, I.size + 1, k, dtype=np.int64)
+    if I.size and (I.min() < 0 or I.max() >= nV):
+        raise MeshFileError(f"{path}: a face index is outside 0 .. {nV - 1}")
+    F, _, split = split_polygons(I, C)
+    return MeshFile(np.ascontiguousarray(V, dtype=np.float64), F, [], split, "igl_hhj (numpy PLY reader)")
+
+
+def _read_polygons(path, ext):
+    """A format libigl lacks (or a polygon PLY) through :mod:`igl_hhj.polygon_io`."""
+    pm = read_polygon_mesh(path)
+    if pm.C.size < 2:
+        raise MeshFileError(f"{path}: no polygons in this {ext} file ({pm.reader})"
+                            + (f": {pm.messages[0]}" if pm.messages else ""))
+    V = pm.V
+    if V.ndim != 2 or V.shape[1] != 3 or not len(V):
+        raise MeshFileError(f"{path}: vertices are not 3D points (shape {V.shape})")
+    if pm.I.size and (pm.I.min() < 0 or pm.I.max() >= len(V)):
+        raise MeshFileError(f"{path}: a face index is outside 0 .. {len(V) - 1}")
+    try:
+        F, J, split = split_polygons(pm.I, pm.C)
+    except ValueError as exc:
+        raise MeshFileError(f"{path}: {exc}") from None
+    messages = list(pm.messages)
+    point_data = dict(pm.point_data)
+    if ext in (".gltf", ".glb", ".3mf") and not point_data:
+        V, F, _ = _weld(V, F, messages, "glTF" if ext != ".3mf" else "3MF")
+    return MeshFile(V, np.ascontiguousarray(F), messages, split, pm.reader, point_data,
+                    {k: v[J] for k, v in pm.cell_data.items()}, pm.active_scalars)
 
 
 # --------------------------------------------------------------------------- writing
@@ -975,3 +1172,190 @@ def write_curvature(path: str | os.PathLike, V: np.ndarray, F: np.ndarray, est: 
         _write_obj(path, V, F, est, quantity)
     else:
         raise MeshFileError(f"{path}: unknown output extension (use {', '.join(OUTPUT_EXTENSIONS)})")
+
+
+# --------------------------------------------------------------------------- reading results back
+RESULT_EXTENSIONS = (".npz", ".ply", ".vtp", ".vtu", ".vtk")
+"""Outputs of :func:`write_curvature` that :func:`read_curvature` (and ``igl-hhj view``) re-open:
+those that hold the mesh with its values (``.csv`` holds no mesh, ``.obj`` only colours)."""
+
+_METHOD_NAMES = {"hhj": "hhj", "igl": "libigl_quadric", "heine": "heine"}
+
+
+@dataclass
+class CurvatureFile:
+    """A curvature result read back by :func:`read_curvature`.
+
+    Attributes
+    ----------
+    V : (#V, 3) float64, F : (#F, 3) int64
+    estimate : igl_hhj.baselines.CurvatureEstimate
+        k1, k2, H, K (and d1, d2 when stored) per ``estimate.location``.
+    method : str, the method stored in the file ("" when the file does not say)
+    quantity : str, what the file was written to show (PLY ``quality``, the VTK active
+        scalars; "H" when it does not say)
+    S : (#F, 3, 3) float64 or None, the HHJ shape operator when stored (``.npz``, VTK
+        cell tensor ``S``)
+    fields : dict name -> array, every numeric per-element array of the file
+    """
+
+    V: NDArray[np.float64]
+    F: NDArray[np.int64]
+    estimate: CurvatureEstimate
+    method: str = ""
+    quantity: str = "H"
+    S: np.ndarray | None = None
+    fields: dict = field(default_factory=dict)
+
+
+def _ply_values(path):
+    """{"vertex": {name: (nV,)}, "face": {name: (nF,)}}: the scalar properties of a PLY of
+    triangles (binary or ascii, checked by ``_check_ply``), and its comment lines."""
+    head = open(path, "rb").read(_HEADER_BYTES)
+    fmt, elements, body_start = _parse_ply_header(path, head)
+    comments = [ln[8:].decode("ascii", "replace") for ln in _ply_head(path, head).split(b"\n")
+                if ln.startswith(b"comment ")]
+    order = {"ascii": "<", "binary_little_endian": "<", "binary_big_endian": ">"}[fmt]
+
+    def scalar(t):
+        kind = "f" if t in ("float", "float32", "double", "float64") else ("u" if t.startswith("u") else "i")
+        return order + kind + str(_PLY_SIZES[t])
+
+    dtypes = []
+    for name, n, props in elements:
+        fields = []
+        for p, t in props:
+            if t[0] == "list":
+                if name != "face":
+                    return {}, comments                    # lists we cannot lay out
+                fields += [("_count", scalar(t[1])), ("_index", scalar(t[2]), (3,))]
+            else:
+                fields.append((p, scalar(t[0])))
+        dtypes.append((name, n, np.dtype(fields)))
+    out = {}
+    if fmt == "ascii":
+        flat = np.fromstring(open(path, "rb").read()[body_start:], sep=" ")
+        start = 0
+        for name, n, dt in dtypes:
+            width = sum(int(np.prod(dt[k].shape)) if dt[k].shape else 1 for k in dt.names)
+            rows = flat[start:start + n * width].reshape(n, width)
+            start += n * width
+            cols, j = {}, 0
+            for k in dt.names:
+                w = int(np.prod(dt[k].shape)) if dt[k].shape else 1
+                if not k.startswith("_"):
+                    cols[k] = rows[:, j]
+                j += w
+            out[name] = cols
+    else:
+        offset = body_start
+        for name, n, dt in dtypes:
+            rec = np.fromfile(path, dtype=dt, count=n, offset=offset)
+            offset += n * dt.itemsize
+            out[name] = {k: rec[k].astype(np.float64) for k in dt.names if not k.startswith("_")}
+    return out, comments
+
+
+def _estimate_from(fields, location, method):
+    from .baselines import CurvatureEstimate
+    have = [q for q in QUANTITIES if q in fields]
+    if len(have) < len(QUANTITIES):
+        raise MeshFileError(f"no curvature arrays {', '.join(q for q in QUANTITIES if q not in have)} per "
+                            f"{location} (it holds: {', '.join(sorted(fields)) or 'nothing'}); "
+                            f"write one with 'igl-hhj curvature MESH -o OUT'")
+    vals = {q: np.asarray(fields[q], dtype=np.float64).reshape(-1) for q in QUANTITIES}
+    if all(f"{k}{c}" in fields for k in ("d1", "d2") for c in "xyz"):          # PLY columns d1x ...
+        d = [np.column_stack([fields[f"{k}{c}"] for c in "xyz"]) for k in ("d1", "d2")]
+    else:
+        d = [np.asarray(fields[k], dtype=np.float64).reshape(-1, 3) if k in fields else None
+             for k in ("d1", "d2")]
+    if d[0] is not None and np.isnan(d[0]).all():                          # written without directions
+        d = [None, None]
+    name = _METHOD_NAMES.get(method, method) or "stored"       # the VTK files do not say
+    if name == "hhj":
+        name = f"hhj_{location}"
+    return CurvatureEstimate(location, vals["k1"], vals["k2"], vals["H"], vals["K"], d[0], d[1],
+                             np.flatnonzero(np.isnan(vals["k1"])), name)
+
+
+def read_curvature(path: str | os.PathLike) -> CurvatureFile:
+    """Read back a curvature result written by :func:`write_curvature` (``igl-hhj curvature -o``).
+
+    Parameters
+    ----------
+    path : str or os.PathLike, extension one of :data:`RESULT_EXTENSIONS`
+        ``.npz``; ``.ply`` (the named vertex or face properties, read with numpy);
+        ``.vtp`` / ``.vtu`` / ``.vtk`` (point or cell data, through
+        :func:`read_mesh_file`: pyvista, or meshio for ``.vtu`` / ``.vtk``).
+
+    Returns
+    -------
+    CurvatureFile
+
+    Raises
+    ------
+    MeshFileError
+        Not such a file, or one without the arrays k1, k2, H, K per vertex or per face.
+    """
+    p = Path(path)
+    ext = p.suffix.lower()
+    if ext not in RESULT_EXTENSIONS:
+        raise MeshFileError(f"{p}: cannot re-open a {p.suffix or 'extension-less'} file: results with "
+                            f"their mesh are {', '.join(RESULT_EXTENSIONS)}"
+                            + (" (a .csv holds no mesh)" if ext == ".csv" else
+                               " (an .obj holds colours, no values)" if ext == ".obj" else ""))
+    method, quantity, S = "", "H", None
+    try:
+        if ext == ".npz":
+            _check_input_file_any(p)
+            try:
+                z = np.load(p, allow_pickle=False)
+                fields = {k: z[k] for k in z.files}
+            except (OSError, ValueError) as exc:
+                raise MeshFileError(f"{p}: not an .npz archive: {exc}") from None
+            V, F = fields.pop("V", None), fields.pop("F", None)
+            if V is None or F is None:
+                raise MeshFileError(f"{p}: no arrays V and F (it holds: {', '.join(sorted(fields))})")
+            location = str(fields.pop("per", "vertex"))
+            method = str(fields.pop("method", ""))
+            S = fields.pop("S", None)
+        else:
+            mf = read_mesh_file(p)
+            V, F = mf.V, mf.F
+            if ext == ".ply":
+                values, comments = _ply_values(p)
+                pdata = {k: v for k, v in values.get("vertex", {}).items() if k not in ("x", "y", "z")}
+                cdata = values.get("face", {})
+                for c in comments:
+                    m = re.search(r"method (\S+), per (vertex|face); quality = (\w+)", c)
+                    if m:
+                        method, quantity = m.group(1), m.group(3)
+            else:
+                pdata, cdata = mf.point_data, mf.cell_data
+                quantity = mf.active_scalars or "H"
+                S = cdata.get("S")
+            location = "vertex" if "H" in pdata else "face"
+            fields = pdata if location == "vertex" else cdata
+        est = _estimate_from(fields, location, method)
+    except MeshFileError as exc:
+        msg = str(exc)
+        raise MeshFileError(msg if msg.startswith(str(p)) else f"{p}: {msg}") from None
+    V = np.asarray(V, dtype=np.float64)
+    F = np.asarray(F, dtype=np.int64)
+    n = len(V) if est.location == "vertex" else len(F)
+    if len(est.k1) != n:
+        raise MeshFileError(f"{p}: {len(est.k1)} values per {est.location}, the mesh has {n} {est.location}s")
+    if S is not None:
+        S = np.asarray(S, dtype=np.float64).reshape(-1, 3, 3)
+    if method.startswith("hhj"):
+        method = "hhj"
+    elif method.startswith("libigl"):
+        method = "igl"
+    return CurvatureFile(V, F, est, method, quantity if quantity in QUANTITIES else "H", S, dict(fields))
+
+
+def _check_input_file_any(path):
+    if not path.exists():
+        raise MeshFileError(f"{path}: no such file")
+    if not path.is_file():
+        raise MeshFileError(f"{path}: not a regular file")

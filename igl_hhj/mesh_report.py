@@ -32,12 +32,16 @@ directions) returns wrong loops; on valid meshes the two agree (tested).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 import warnings
 
 from .mesh import MeshDefectError, MeshWarning, TriangleMesh, zero_area_faces
+
+if TYPE_CHECKING:
+    from .polygon_io import PolygonSplit
 
 __all__ = ["MeshReport", "mesh_report"]
 
@@ -79,6 +83,13 @@ class MeshReport:
     mean_edge_length: float | None = None
     repairs: dict | None = None
     repair_note: str = ""
+    polygons: dict | None = None
+    polygon_note: str = ""
+
+    @property
+    def n_quads_split(self) -> int:
+        """Quads of the file split into two triangles each (0 when not read from a file)."""
+        return int((self.polygons or {}).get(4, 0))
 
     def lines(self):
         """The report as text lines (``igl-hhj info`` prints them)."""
@@ -86,6 +97,8 @@ class MeshReport:
         out = [f"vertices          {self.n_vertices}"
                + ("" if self.n_unreferenced is None else f" ({self.n_unreferenced} unreferenced)"),
                f"faces             {self.n_faces}"]
+        if self.polygon_note:
+            out.append(f"polygons          {self.polygon_note}")
         if self.n_edges is None:
             out.append(f"topology          not analysed: {self.topology_note}")
         else:
@@ -163,13 +176,17 @@ def _repairs(V, F, defect):
                               "functions refuse it unless repair=True")
 
 
-def mesh_report(V, F):
+def mesh_report(V: Any, F: Any, split: PolygonSplit | None = None) -> MeshReport:
     """Analyse ``(V, F)`` without requiring a valid mesh.
 
     Parameters
     ----------
     V : (#V, 3) float array
     F : (#F, k) integer array as read from a file (k = 3 for triangles)
+    split : igl_hhj.polygon_io.PolygonSplit, optional
+        The file's polygons before they were split (:attr:`igl_hhj.mesh_io.MeshFile.split`):
+        ``polygons`` ({corners: count}), ``n_quads_split`` and the "polygons" line
+        ("12 quads split into 24 triangles ...") report it.
 
     Returns
     -------
@@ -191,6 +208,9 @@ def mesh_report(V, F):
         accepted, reason = False, str(exc)
     nV, nF = len(V), len(F)
     rep = MeshReport(n_vertices=nV, n_faces=nF, accepted=accepted, reason=reason)
+    if split is not None:
+        rep.polygons = dict(split.corners)
+        rep.polygon_note = split.describe()
     if not accepted:
         rep.repairs, rep.repair_note = _repairs(V, F, defect)
     if V.ndim == 2 and V.shape[1] == 3 and nV and np.isfinite(V).all():

@@ -35,6 +35,7 @@ from __future__ import annotations
 import contextvars
 import warnings
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -128,7 +129,7 @@ def _inconsistent_faces(F):
     return bad_edge[inv].reshape(3, nF).any(axis=0)
 
 
-def repair_mesh(V, F):
+def repair_mesh(V: Any, F: Any) -> RepairedMesh:
     """Repair the defects that :class:`igl_hhj.mesh.TriangleMesh` refuses and libigl accepts.
 
     Parameters

@@ -60,7 +60,7 @@ __all__ = [
     "ViewerUnavailable", "QuantityInfo", "Registration", "QUANTITIES", "METHODS",
     "init", "show", "color_range", "curvature_estimate", "local_edge_length",
     "register_curvature", "register_comparison", "register_hessian", "register_biharmonic",
-    "register_regge_curvature", "register_scalars", "merge", "screenshot",
+    "register_regge_curvature", "register_scalars", "register_result", "merge", "screenshot",
     "VIEWS", "best_view_direction", "view_rotation", "to_image", "REPR_PNG_SIZE",
 ]
 
@@ -692,6 +692,45 @@ def register_curvature(V: Any, F: Any = None, estimate=None, *, method="hhj", pe
         _add_estimate(reg, name, mesh, est, tag, reg.ranges, cmap, directions, direction_scale,
                       enabled=enabled if i == 0 else None, show_directions=show_directions and i == 0)
     return _finish(reg, screenshot, size)
+
+
+def register_result(path: str | os.PathLike, *, enabled: str | None = None, name: str | None = None,
+                    robust: float | None = 1.0, view: Any = None, show_directions: bool = False,
+                    screenshot: str | os.PathLike | None = None, size: tuple[int, int] = (1024, 768)) -> Registration:
+    """Re-open a saved curvature result with its stored quantities (``igl-hhj view``).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A file of ``igl-hhj curvature -o`` / :func:`igl_hhj.mesh_io.write_curvature`
+        (:data:`igl_hhj.mesh_io.RESULT_EXTENSIONS`: ``.npz``, ``.ply``, ``.vtp``, ``.vtu``,
+        ``.vtk``), read by :func:`igl_hhj.mesh_io.read_curvature`.
+    enabled : {"k1", "k2", "H", "K"}, optional
+        Quantity shown first (default: the one the file was written to show, its PLY
+        ``quality`` or VTK active scalars; else H).
+    name : str, optional, structure name (default: the file's stem).
+    robust, view, show_directions, screenshot, size : as :func:`register_curvature`.
+
+    Returns
+    -------
+    Registration
+        κ1, κ2, H, K per vertex or per face as stored, and the principal directions
+        PD1, PD2 when the file has them; the title names the file, the method and
+        where the values live.
+    """
+    from pathlib import Path
+
+    from .mesh_io import read_curvature
+    if enabled is not None:
+        _check(enabled, "enabled", QUANTITIES)
+    cf = read_curvature(path)
+    tag = _tag_of(cf.estimate)
+    where = cf.estimate.location
+    title = (f"{Path(path).name}: {METHOD_TITLES.get(tag, 'stored curvature')}, per {where} — "
+             f"{len(cf.F):,} faces")
+    return register_curvature(cf.V, cf.F, estimate=cf.estimate, name=name or Path(path).stem,
+                              enabled=enabled or cf.quantity, robust=robust, view=view,
+                              show_directions=show_directions, title=title, screenshot=screenshot, size=size)
 
 
 def _tag_of(est):
@@ -1338,7 +1377,8 @@ def _frame(ps, bounds, width, height, margin=0.04, top_px=0, left_px=0):
     return (float(target[0]), float(target[1])), wpp
 
 
-def screenshot(path, registration=None, *, size=(1024, 768), annotate=True) -> str:
+def screenshot(path: str | os.PathLike, registration: Any = None, *, size: tuple[int, int] = (1024, 768),
+               annotate: bool = True) -> str:
     """Render headless (EGL, unless an interactive backend is running) and save a PNG.
 
     Parameters

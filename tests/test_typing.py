@@ -83,6 +83,23 @@ reveal_type(igl_hhj.curvature_of(V, F, kind="gauss", per="face"))
 reveal_type(igl_hhj.curvature_of(V, F, kind="directions"))
 reveal_type(viewer.register_curvature)
 reveal_type(igl_hhj.viewer.to_image)
+reveal_type(igl_hhj.viewer.register_curvature(V, F))
+reveal_type(igl_hhj.viewer.register_result("bunny_H.ply"))
+reveal_type(igl_hhj.viewer.screenshot)
+reveal_type(igl_hhj.mesh_io.read_mesh("bunny.off"))
+reveal_type(igl_hhj.mesh_io.read_mesh_file("bunny.glb").split)
+reveal_type(igl_hhj.mesh_io.read_curvature("bunny_H.vtp").estimate)
+reveal_type(igl_hhj.mesh_io.write_curvature)
+reveal_type(igl_hhj.vtk_files.write_vtk)
+reveal_type(igl_hhj.polygon_io.split_polygons([0, 1, 2, 3], [0, 4]))
+reveal_type(igl_hhj.baselines.estimate("hhj_vertex", V, F))
+reveal_type(igl_hhj.baselines.hhj_vertex(V, F).H)
+reveal_type(igl_hhj.baselines.libigl_quadric(V, F))
+reveal_type(igl_hhj.mesh_report.mesh_report(V, F))
+reveal_type(igl_hhj.regge.gauss_curvature(V, F))
+reveal_type(igl_hhj.repair.repair_mesh(V, F))
+reveal_type(igl_hhj.surfaces.icosphere(2))
+reveal_type(igl_hhj.convergence.eoc([1.0, 0.5], [0.2, 0.1]))
 PD1, PD2, PV1, PV2, bad = igl_hhj.principal_curvature(V, F)
 reveal_type(PV1)
 reveal_type(bad)
@@ -145,6 +162,25 @@ def test_user_script_sees_the_real_types(tmp_path):
     assert revealed["bad"] == "list[int]"
     assert revealed["viewer.register_curvature"].endswith("-> igl_hhj.viewer.Registration")
     assert revealed["igl_hhj.viewer.to_image"].endswith("-> NDArray[uint8]")
+    # submodule entry points, reached as attributes of igl_hhj (the lazy __getattr__)
+    for call in ('igl_hhj.viewer.register_curvature(V, F)', 'igl_hhj.viewer.register_result("bunny_H.ply")'):
+        assert revealed[call] == "igl_hhj.viewer.Registration", (call, revealed[call])
+    assert revealed["igl_hhj.viewer.screenshot"].endswith("-> str")
+    assert revealed['igl_hhj.mesh_io.read_mesh("bunny.off")'] == f"tuple[{F64}, NDArray[int64], list[str]]"
+    assert revealed['igl_hhj.mesh_io.read_mesh_file("bunny.glb").split'] == "igl_hhj.polygon_io.PolygonSplit"
+    assert revealed['igl_hhj.mesh_io.read_curvature("bunny_H.vtp").estimate'] == "igl_hhj.baselines.CurvatureEstimate"
+    assert "quantity: str =" in revealed["igl_hhj.mesh_io.write_curvature"]
+    assert "point_data: typing.Mapping[str, Any] | None =" in revealed["igl_hhj.vtk_files.write_vtk"]
+    assert revealed["igl_hhj.polygon_io.split_polygons([0, 1, 2, 3], [0, 4])"] == \
+        "tuple[NDArray[int64], NDArray[int64], igl_hhj.polygon_io.PolygonSplit]"
+    for call in ('igl_hhj.baselines.estimate("hhj_vertex", V, F)', "igl_hhj.baselines.libigl_quadric(V, F)"):
+        assert revealed[call] == "igl_hhj.baselines.CurvatureEstimate", (call, revealed[call])
+    assert revealed["igl_hhj.baselines.hhj_vertex(V, F).H"] == F64
+    assert revealed["igl_hhj.mesh_report.mesh_report(V, F)"] == "igl_hhj.mesh_report.MeshReport"
+    assert revealed["igl_hhj.regge.gauss_curvature(V, F)"] == F64
+    assert revealed["igl_hhj.repair.repair_mesh(V, F)"] == "igl_hhj.repair.RepairedMesh"
+    assert revealed["igl_hhj.surfaces.icosphere(2)"] == f"tuple[{F64}, NDArray[int64]]"
+    assert revealed["igl_hhj.convergence.eoc([1.0, 0.5], [0.2, 0.1])"] == F64
 
 
 def test_decorated_functions_keep_their_signature():
@@ -185,8 +221,12 @@ def test_public_functions_are_annotated():
     import inspect
 
     import igl_hhj
-    from igl_hhj import convergence, interop, mesh_io, viewer
-    functions = [igl_hhj.shape_operator, igl_hhj.surface_hessian, igl_hhj.principal_curvature,
+    from igl_hhj import baselines, convergence, interop, mesh_io, mesh_report, polygon_io, regge, repair, viewer
+    from igl_hhj.surfaces import icosphere
+    functions = [mesh_io.read_mesh, mesh_io.read_mesh_file, mesh_io.read_curvature, polygon_io.split_polygons,
+                 polygon_io.read_polygon_mesh, baselines.estimate, baselines.hhj_vertex, baselines.hhj_face,
+                 baselines.libigl_quadric, baselines.libigl_cotan, baselines.heine, mesh_report.mesh_report,
+                 regge.gauss_curvature, repair.repair_mesh, icosphere, viewer.register_result,igl_hhj.shape_operator, igl_hhj.surface_hessian, igl_hhj.principal_curvature,
                  igl_hhj.face_principal_curvature, igl_hhj.face_mean_curvature, igl_hhj.face_gaussian_curvature,
                  igl_hhj.curvature_of, igl_hhj.biharmonic_solve, igl_hhj.validate_mesh, igl_hhj.boundary_treatment,
                  convergence.eoc, convergence.plot_convergence, mesh_io.write_curvature,

@@ -29,7 +29,10 @@ Conventions
 """
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
+from numpy.typing import NDArray
 
 from ..mesh import _as_array, as_mesh, validate_faces
 
@@ -218,7 +221,8 @@ def gauss_curvature_intrinsic(l_sq, F, *, boundary="natural", mass="consistent")
     return _lift(Lf, F, nV, uE, count, boundary, mass)
 
 
-def gauss_curvature(V, F=None, *, boundary="natural", mass="consistent"):
+def gauss_curvature(V: Any, F: Any = None, *, boundary: str = "natural",
+                    mass: str = "consistent") -> NDArray[np.float64]:
     """P1 lifting of the distributional Gauss curvature of the edge-length
     (degree-0 Regge) metric of an embedded mesh.
 

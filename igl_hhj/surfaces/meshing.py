@@ -7,6 +7,7 @@ new vertex projected onto the exact surface.  All generators are seeded.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .exact import Ellipsoid, GraphSurface, ImplicitSurface, Sphere, WalkerTorus
 
@@ -106,7 +107,7 @@ def jitter_tangentially(V, F, surface: ImplicitSurface, amount=0.2, seed=0, fixe
     return W
 
 
-def icosphere(subdivisions=1):
+def icosphere(subdivisions: int = 1) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     """Unit icosphere: ``igl.icosahedron`` with ``subdivisions`` normalised upsamplings."""
     import igl
     V, F = igl.icosahedron()

@@ -1,0 +1,362 @@
+"""Polygon meshes: the formats libigl does not read, and the one rule that splits polygons.
+
+libigl 2.6 reads ``.obj .off .ply .stl .wrl .mesh .msh`` (:func:`igl_hhj.mesh_io.read_mesh`
+guards it).  This module reads the rest through optional packages, imported only
+when such a file is read:
+
+==============  ===========================================  ==================
+extension       what                                         read with
+==============  ===========================================  ==================
+``.gltf .glb``  glTF 2.0 (scenes flattened, transforms       trimesh
+                applied)
+``.3mf``        3D Manufacturing Format                      trimesh (+ lxml)
+``.vtp``        VTK XML PolyData                             pyvista
+``.vtu .vtk``   VTK XML UnstructuredGrid, legacy VTK         pyvista, else meshio
+``.ply``        a PLY with quads or other polygons (libigl    pyvista
+                aborts on them; triangle PLYs stay with
+                libigl)
+==============  ===========================================  ==================
+
+A missing package is a ``ModuleNotFoundError`` whose message names the file and the
+command that installs it (:func:`igl_hhj.errors.install_hint`; all of them are in
+the ``io`` extra: ``pip install ".[io]"`` in a checkout).
+
+Splitting polygons
+------------------
+Every reader hands its faces on as polygons in the compressed form
+``(I, C)`` of :func:`igl.polygons_to_triangles` (corner indices ``I``, cumulative
+sizes ``C``: polygon ``p`` is ``I[C[p]:C[p+1]]``), and every polygon with
+``k > 3`` corners becomes the ``k - 2`` triangles of the *fan from its first
+corner*,
+
+.. math::  (i_0, i_1, \\dots, i_{k-1}) \\mapsto (i_0, i_{j}, i_{j+1}),\\quad j = 1, \\dots, k-2,
+
+in file order (``igl.polygons_to_triangles``).  It is the rule libigl's own OBJ and
+OFF readers apply, so a quad mesh gives the same triangles whatever format it was
+stored in (tested); a quad ``(a, b, c, d)`` is split along its diagonal ``a c``.
+Triangles are kept as they are.  :class:`PolygonSplit` counts what was split
+(``igl-hhj info``: "12 quads split into 24 triangles").
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["EXTRA_EXTENSIONS", "SPLIT_RULE", "PolygonSplit", "PolygonMesh", "polygon_split",
+           "split_polygons", "read_polygon_mesh"]
+
+EXTRA_EXTENSIONS: dict[str, tuple[str, ...]] = {
+    ".gltf": ("trimesh",), ".glb": ("trimesh",), ".3mf": ("trimesh",),
+    ".vtp": ("pyvista",), ".vtu": ("pyvista", "meshio"), ".vtk": ("pyvista", "meshio"),
+}
+"""Extension -> the optional packages that read it, in order of preference."""
+
+SPLIT_RULE = "fan from each polygon's first corner, as libigl's OBJ/OFF readers"
+"""How polygons with more than three corners become triangles (:func:`split_polygons`)."""
+
+_NAMES = {4: "quad", 5: "pentagon", 6: "hexagon"}
+
+# VTK cell types of surface cells
+_VTK_TRIANGLE, _VTK_POLYGON, _VTK_QUAD = 5, 7, 9
+_VTK_SURFACE = (_VTK_TRIANGLE, _VTK_POLYGON, _VTK_QUAD)
+_VTK_NAMES = {1: "vertex", 2: "poly_vertex", 3: "line", 4: "poly_line", 6: "triangle_strip",
+              8: "pixel", 10: "tetra", 11: "voxel", 12: "hexahedron", 13: "wedge", 14: "pyramid"}
+
+
+def _plural(n, name):
+    return f"{n} {name}" + ("" if n == 1 else ("es" if name.endswith("x") else "s"))
+
+
+@dataclass(frozen=True)
+class PolygonSplit:
+    """What splitting a polygon mesh into triangles did.
+
+    Attributes
+    ----------
+    corners : dict {k: count}
+        Number of faces of the file with ``k`` corners (triangles included).
+    """
+
+    corners: dict = field(default_factory=dict)
+
+    @property
+    def n_polygons(self) -> int:
+        """Faces of the file (all corner counts)."""
+        return int(sum(self.corners.values()))
+
+    @property
+    def n_quads(self) -> int:
+        """Faces with four corners."""
+        return int(self.corners.get(4, 0))
+
+    @property
+    def n_split(self) -> int:
+        """Faces with more than three corners (the ones split)."""
+        return int(sum(n for k, n in self.corners.items() if k > 3))
+
+    @property
+    def n_triangles(self) -> int:
+        """Triangles after the split: ``sum (k - 2)`` over the faces."""
+        return int(sum((k - 2) * n for k, n in self.corners.items()))
+
+    @property
+    def n_from_split(self) -> int:
+        """Triangles made from the split faces: ``sum (k - 2)`` over ``k > 3``."""
+        return int(sum((k - 2) * n for k, n in self.corners.items() if k > 3))
+
+    def describe(self) -> str:
+        """One line, e.g. ``"12 quads split into 24 triangles"`` (empty when nothing was split)."""
+        if not self.n_split:
+            return ""
+        parts = [_plural(n, _NAMES.get(k, f"{k}-gon")) for k, n in sorted(self.corners.items()) if k > 3]
+        kept = self.corners.get(3, 0)
+        return (", ".join(parts) + f" split into {self.n_from_split} triangles ({SPLIT_RULE})"
+                + (f"; {_plural(kept, 'triangle')} kept" if kept else ""))
+
+
+def polygon_split(sizes: Any) -> PolygonSplit:
+    """:class:`PolygonSplit` of faces with ``sizes[p]`` corners ((#P,) int)."""
+    k, n = np.unique(np.asarray(sizes, dtype=np.int64), return_counts=True)
+    return PolygonSplit({int(a): int(b) for a, b in zip(k, n)})
+
+
+def split_polygons(I: Any, C: Any) -> tuple[NDArray[np.int64], NDArray[np.int64], PolygonSplit]:
+    """Triangles of a polygon mesh: the fan from each polygon's first corner.
+
+    Parameters
+    ----------
+    I : (#I,) int, corner indices of all polygons one after the other
+    C : (#P + 1,) int, cumulative sizes, ``C[0] = 0``: polygon ``p`` is ``I[C[p]:C[p+1]]``
+
+    Returns
+    -------
+    F : (#F, 3) int64, ``#F = sum (k_p - 2)``, the triangles of each polygon consecutive
+        and in polygon order (``igl.polygons_to_triangles``)
+    J : (#F,) int64, the polygon each triangle comes from
+    split : PolygonSplit
+
+    Raises
+    ------
+    ValueError
+        ``C`` not starting at 0, decreasing, not ending at ``len(I)``, or a polygon
+        with fewer than 3 corners.
+    """
+    I = np.ascontiguousarray(I, dtype=np.int64).ravel()
+    C = np.ascontiguousarray(C, dtype=np.int64).ravel()
+    if C.size < 1 or C[0] != 0 or C[-1] != I.size:
+        raise ValueError(f"C must run from 0 to len(I) = {I.size}, got {C[:1].tolist()} ... {C[-1:].tolist()}")
+    sizes = np.diff(C)
+    if (sizes < 3).any():
+        p = int(np.flatnonzero(sizes < 3)[0])
+        raise ValueError(f"polygon {p} has {int(sizes[p])} corners (a face needs at least 3)")
+    split = polygon_split(sizes)
+    if sizes.size and (sizes == 3).all():                 # triangles: nothing to split
+        return I.reshape(-1, 3), np.arange(sizes.size, dtype=np.int64), split
+    import igl
+    F, J = igl.polygons_to_triangles(I, C)
+    return np.asarray(F, dtype=np.int64), np.asarray(J, dtype=np.int64), split
+
+
+@dataclass
+class PolygonMesh:
+    """A polygon mesh read by :func:`read_polygon_mesh`.
+
+    Attributes
+    ----------
+    V : (#V, 3) float64
+    I, C : polygons in the form of :func:`split_polygons`
+    point_data : dict name -> (#V, ...) array
+    cell_data : dict name -> (#P, ...) array, one row per polygon
+    reader : str, the package that read the file
+    active_scalars : str or None, the array the file marks active (pyvista only)
+    messages : list of str, what was dropped or merged while reading
+    """
+
+    V: NDArray[np.float64]
+    I: NDArray[np.int64]
+    C: NDArray[np.int64]
+    point_data: dict = field(default_factory=dict)
+    cell_data: dict = field(default_factory=dict)
+    reader: str = ""
+    messages: list = field(default_factory=list)
+    active_scalars: str | None = None
+
+
+def _import(package, path):
+    """Import an optional reader package; a ModuleNotFoundError naming the file and the fix."""
+    import importlib
+
+    from .errors import install_hint
+    try:
+        return importlib.import_module(package)
+    except ModuleNotFoundError as exc:
+        missing = (exc.name or package).split(".")[0]
+        raise ModuleNotFoundError(f"{path}: reading {Path(path).suffix} files needs {missing}: "
+                                  f"{install_hint(missing)}", name=missing) from None
+
+
+def _error(path, exc):
+    from .mesh_io import MeshFileError
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    return MeshFileError(f"{path}: could not read it: {text[:200]}")
+
+
+def read_polygon_mesh(path: str | os.PathLike, readers: tuple[str, ...] | None = None) -> PolygonMesh:
+    """Read a mesh in one of :data:`EXTRA_EXTENSIONS` (or a polygon ``.ply``) as polygons.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    readers : tuple of package names, optional
+        Which packages to try (default: those of :data:`EXTRA_EXTENSIONS`, for
+        ``.ply`` pyvista); the first importable one reads the file.
+
+    Returns
+    -------
+    PolygonMesh
+
+    Raises
+    ------
+    ModuleNotFoundError
+        None of the packages is installed (the message names the install command).
+    igl_hhj.mesh_io.MeshFileError
+        The package could not read the file, or it holds no surface cells.
+    """
+    path = Path(path)
+    ext = path.suffix.lower()
+    if readers is None:
+        readers = EXTRA_EXTENSIONS.get(ext, ("pyvista",))
+    import importlib
+    chosen = readers[0]
+    for r in readers:
+        try:
+            importlib.import_module(r)
+        except ImportError:
+            continue
+        chosen = r
+        break
+    if chosen == "trimesh":
+        return _read_trimesh(path)
+    if chosen == "pyvista":
+        return _read_pyvista(path)
+    if chosen == "meshio":
+        return _read_meshio(path)
+    raise ValueError(f"unknown reader {chosen!r} (use trimesh, pyvista or meshio)")
+
+
+def _triangles(F):
+    F = np.asarray(F, dtype=np.int64).reshape(-1, 3)
+    return F.ravel(), np.arange(0, F.size + 1, 3, dtype=np.int64)
+
+
+def _read_trimesh(path):
+    trimesh = _import("trimesh", path)
+    from .mesh_io import CapturedOutput
+    try:
+        with CapturedOutput():
+            mesh = trimesh.load(str(path), force="mesh", process=False)
+    except ModuleNotFoundError as exc:                      # lxml for 3MF
+        raise _import(exc.name or "lxml", path) from None
+    except Exception as exc:                               # trimesh raises many kinds
+        raise _error(path, exc) from None
+    V = np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), dtype=np.float64)
+    F = np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), dtype=np.int64)
+    I, C = _triangles(F)
+    return PolygonMesh(V, I, C, reader=f"trimesh {trimesh.__version__}")
+
+
+def _cell_array(offsets, connectivity):
+    return (np.asarray(connectivity, dtype=np.int64).ravel(), np.asarray(offsets, dtype=np.int64).ravel())
+
+
+def _arrays(data, rows=None):
+    out = {}
+    for name in data.keys():
+        a = np.asarray(data[name])
+        if a.ndim == 2 and a.shape[1] == 1:                # meshio's legacy reader: (n, 1) scalars
+            a = a[:, 0]
+        if a.dtype.kind in "fiub":
+            out[str(name)] = a if rows is None else a[rows]
+    return out
+
+
+def _read_pyvista(path):
+    pv = _import("pyvista", path)
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from .mesh_io import CapturedOutput
+    import warnings
+    try:
+        with warnings.catch_warnings(record=True) as caught, CapturedOutput():
+            warnings.simplefilter("always")
+            ds = pv.read(str(path))
+    except Exception as exc:                               # VTK readers raise many kinds
+        raise _error(path, exc) from None
+    messages = [" ".join(str(w.message).split())[:200] for w in caught]
+    if isinstance(ds, pv.MultiBlock):
+        ds = ds.combine()
+    if isinstance(ds, pv.PolyData):
+        polys = ds.GetPolys()
+        I, C = _cell_array(vtk_to_numpy(polys.GetOffsetsArray()), vtk_to_numpy(polys.GetConnectivityArray()))
+        first = ds.n_verts + ds.n_lines                     # VTK numbers cells verts, lines, polys, strips
+        rows = np.arange(first, first + C.size - 1)
+        dropped = {"vertex": ds.n_verts, "line": ds.n_lines, "triangle_strip": ds.n_strips}
+    else:
+        types = np.asarray(ds.celltypes)
+        offsets = np.asarray(ds.cell_offsets if hasattr(ds, "cell_offsets") else ds.offset, dtype=np.int64)
+        conn = np.asarray(ds.cell_connectivity, dtype=np.int64)
+        rows = np.flatnonzero(np.isin(types, _VTK_SURFACE))
+        other, n_other = np.unique(types[~np.isin(types, _VTK_SURFACE)], return_counts=True)
+        dropped = {_VTK_NAMES.get(int(t), f"type {int(t)}"): int(n) for t, n in zip(other, n_other)}
+        sizes = offsets[rows + 1] - offsets[rows]
+        C = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+        take = np.repeat(offsets[rows], sizes) + (np.arange(C[-1]) - np.repeat(C[:-1], sizes))
+        I = conn[take]
+    dropped = {k: int(n) for k, n in dropped.items() if n}
+    if dropped:
+        messages.append("ignored cells that are not polygons: "
+                        + ", ".join(f"{n} {k}" for k, n in dropped.items()))
+    V = np.asarray(ds.points, dtype=np.float64).reshape(-1, 3)
+    active = ds.point_data.active_scalars_name or ds.cell_data.active_scalars_name
+    return PolygonMesh(V, I, C, point_data=_arrays(ds.point_data), cell_data=_arrays(ds.cell_data, rows),
+                       reader=f"pyvista {pv.__version__}", messages=messages, active_scalars=active)
+
+
+def _read_meshio(path):
+    meshio = _import("meshio", path)
+    from .mesh_io import CapturedOutput
+    try:
+        with CapturedOutput():
+            m = meshio.read(str(path))
+    except Exception as exc:                               # meshio raises many kinds
+        raise _error(path, exc) from None
+    keep = [j for j, b in enumerate(m.cells) if b.type in ("triangle", "quad") or b.type.startswith("polygon")]
+    dropped = {}
+    for j, b in enumerate(m.cells):
+        if j not in keep:
+            dropped[b.type] = dropped.get(b.type, 0) + len(b.data)
+    blocks = [np.asarray(m.cells[j].data, dtype=np.int64) for j in keep]
+    I = np.concatenate([b.ravel() for b in blocks]) if blocks else np.zeros(0, dtype=np.int64)
+    sizes = np.concatenate([np.full(len(b), b.shape[1]) for b in blocks]) if blocks else np.zeros(0, np.int64)
+    C = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    cell_data = {}
+    for name, per_block in m.cell_data.items():
+        parts = [np.asarray(per_block[j]) for j in keep]
+        parts = [p[:, 0] if p.ndim == 2 and p.shape[1] == 1 else p for p in parts]
+        if parts and all(p.dtype.kind in "fiub" for p in parts):
+            cell_data[str(name)] = np.concatenate(parts)
+    messages = []
+    if dropped:
+        messages.append("ignored cells that are not polygons: "
+                        + ", ".join(f"{n} {k}" for k, n in dropped.items()))
+    if len({m.cells[j].type for j in keep}) > 1:
+        messages.append("meshio groups cells by type: the faces are in that order, not the file's")
+    P = np.asarray(m.points, dtype=np.float64)
+    if P.ndim == 2 and P.shape[1] == 2:                     # planar meshes: z = 0
+        P = np.column_stack([P, np.zeros(len(P))])
+    return PolygonMesh(P, I, C, point_data=_arrays(m.point_data), cell_data=cell_data,
+                       reader=f"meshio {meshio.__version__}", messages=messages)
