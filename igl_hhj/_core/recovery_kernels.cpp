@@ -177,7 +177,18 @@ void patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double*
 void intrinsic_patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S,
                               const double* N, const double* w, const unsigned char* ref, double h,
                               double* X, double* rough, int nt) {
-    // corner components and cosines, one pass over faces (parallel: no scatter)
+    // vertex frames once (tangent_frame of N, +z where N is not finite), then the corner
+    // components and cosines in one pass over faces (parallel: no scatter)
+    std::vector<double> fr((size_t)nV * 9);
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+    for (i64 v = 0; v < nV; ++v) {
+        double* n = &fr[9 * v];
+        const bool fin = std::isfinite(N[3 * v]) && std::isfinite(N[3 * v + 1]) && std::isfinite(N[3 * v + 2]);
+        for (int a = 0; a < 3; ++a) n[a] = fin ? N[3 * v + a] : (a == 2 ? 1.0 : 0.0);
+        tangent_frame(n, n + 3, n + 6);
+    }
     std::vector<double> Y((size_t)nF * 9), cosine((size_t)nF * 3);
 #ifdef IGL_HHJ_OPENMP
 #pragma omp parallel for schedule(static) num_threads(nt)
@@ -189,14 +200,10 @@ void intrinsic_patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, con
         const double nu[3] = {c[0] / nc, c[1] / nc, c[2] / nc};
         const double* Sf = S + 9 * f;
         for (int k = 0; k < 3; ++k) {
-            const i64 v = F[3 * f + k];
-            double n[3], e1[3], e2[3];
-            const bool fin = std::isfinite(N[3 * v]) && std::isfinite(N[3 * v + 1]) && std::isfinite(N[3 * v + 2]);
-            for (int a = 0; a < 3; ++a) n[a] = fin ? N[3 * v + a] : (a == 2 ? 1.0 : 0.0);
-            tangent_frame(n, e1, e2);
+            const double* n = &fr[9 * F[3 * f + k]];
             double f1[3], f2[3];
-            const double cs = min_rotation(e1, n, nu, f1);
-            min_rotation(e2, n, nu, f2);
+            const double cs = min_rotation(n + 3, n, nu, f1);
+            min_rotation(n + 6, n, nu, f2);
             double Sf1[3], Sf2[3];
             for (int p = 0; p < 3; ++p) {
                 Sf1[p] = Sf[3 * p] * f1[0] + Sf[3 * p + 1] * f1[1] + Sf[3 * p + 2] * f1[2];
@@ -209,6 +216,7 @@ void intrinsic_patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, con
             cosine[3 * f + k] = cs;
         }
     }
+    std::vector<double>().swap(fr);
     std::fill(X, X + (size_t)nV * 3, 0.0);
     patch_fit(V, F, nF, nV, N, ref, h, [&](i64 f, int c) { return cosine[3 * f + c] > 0 ? w[f] : 0.0; },
               [&](i64 f, int c, i64 v, double k) {
