@@ -1,0 +1,112 @@
+"""An exact surface with creases: the closed cylinder with flat caps (issue 27).
+
+``x² + y² = R², |z| ≤ L/2`` plus the two discs ``|z| = L/2, x² + y² ≤ R²``.  With
+outward normals the side has κ1 = 1/R, κ2 = 0, H = 1/(2R); the caps are flat; the two
+rims are convex creases of dihedral angle π/2, so ``∫_crease θ ds = 2 · (π/2) · 2πR``.
+
+:func:`capped_cylinder` gives a non-uniform mesh sequence: a jittered coarse mesh
+(the caps are the jittered Delaunay discs of
+:func:`igl_hhj.surfaces.biharmonic_problems.disk_mesh`, the side a jittered grid whose
+top and bottom rows are the caps' rims) refined uniformly 1 → 4 with every new vertex
+of a side edge projected radially onto the cylinder (midpoints of cap edges stay in the
+cap plane; midpoints of rim edges go to the rim circle).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["capped_cylinder", "CappedCylinder"]
+
+
+class CappedCylinder:
+    """The exact capped cylinder of radius ``radius`` and height ``height`` (centred at 0)."""
+
+    def __init__(self, radius=1.0, height=1.5):
+        self.radius = float(radius)
+        self.height = float(height)
+
+    @property
+    def crease_integral(self):
+        """∫_crease θ ds = 2 rims × (π/2) × 2πR."""
+        return 2 * (np.pi / 2) * 2 * np.pi * self.radius
+
+    def side_mean_curvature(self):
+        """H on the side, 1/(2R) (outward normals)."""
+        return 0.5 / self.radius
+
+    def mean_curvature_of_faces(self, face_normals):
+        """(#F,) exact H of the patch a face lies on: 0 on caps (|ν_z| > 1/2), 1/(2R) on the side."""
+        return np.where(np.abs(face_normals[:, 2]) > 0.5, 0.0, self.side_mean_curvature())
+
+
+def _subdivide(V, F, on_side, R):
+    """One 1 → 4 midpoint subdivision; midpoints of edges with both ends on the cylinder
+    (side and rim edges) are projected radially onto it.  Old vertices keep their index."""
+    nV = len(V)
+    H = np.concatenate([F[:, [1, 2]], F[:, [2, 0]], F[:, [0, 1]]])     # half-edge opposite corner k
+    uE, inv = np.unique(np.sort(H, axis=1), axis=0, return_inverse=True)
+    inv = inv.ravel()
+    M = 0.5 * (V[uE[:, 0]] + V[uE[:, 1]])
+    side = on_side[uE[:, 0]] & on_side[uE[:, 1]]
+    M[side, :2] *= R / np.linalg.norm(M[side, :2], axis=1, keepdims=True)
+    m = (nV + inv).reshape(3, len(F)).T                                # m[:, k] midpoint opposite k
+    F2 = np.concatenate([
+        np.column_stack([F[:, 0], m[:, 2], m[:, 1]]),
+        np.column_stack([F[:, 1], m[:, 0], m[:, 2]]),
+        np.column_stack([F[:, 2], m[:, 1], m[:, 0]]),
+        m,
+    ])
+    return np.vstack([V, M]), F2, np.concatenate([on_side, side])
+
+
+def capped_cylinder(levels=0, rings=3, amount=0.25, seed=0, radius=1.0, height=1.5):
+    """Non-uniform closed mesh of the capped cylinder (:class:`CappedCylinder`), outward normals.
+
+    Parameters
+    ----------
+    levels : int, uniform refinements of the coarse mesh (h halves per level).
+    rings : int, rings of the coarse cap discs (6·rings vertices around).
+    amount : float in [0, 0.5), jitter relative to the local spacing.
+    seed : int
+
+    Returns
+    -------
+    V : (#V, 3) float64, F : (#F, 3) int64, on_side : (#V,) bool (vertices on the cylinder,
+        rims included)
+    """
+    from .biharmonic_problems import _disk_parameter_mesh
+    R, L = float(radius), float(height)
+    rng = np.random.default_rng(seed)
+    n = 6 * rings
+    caps = []
+    for k, z in enumerate((-0.5 * L, 0.5 * L)):
+        P, Fd = _disk_parameter_mesh(rings, amount, seed + 1 + k)
+        Vd = np.column_stack([R * P, np.full(len(P), z)])
+        rim = np.arange(len(P) - n, len(P))                            # the boundary ring, by angle
+        if z < 0:
+            Fd = Fd[:, [0, 2, 1]]                                      # bottom cap: normal -z
+        caps.append((Vd, Fd, rim))
+    m = max(2, int(round(L * n / (2 * np.pi * R))))                    # side rows
+    rows = []
+    for j in range(1, m):
+        phi = 2 * np.pi * (np.arange(n) + rng.uniform(0, 1)) / n \
+            + amount * 2 * np.pi / n * rng.uniform(-1, 1, n)
+        z = -0.5 * L + (j + amount * rng.uniform(-1, 1, n)) * L / m
+        rows.append(np.column_stack([R * np.cos(phi), R * np.sin(phi), z]))
+    (Vb, Fb, rb), (Vt, Ft, rt) = caps
+    off_t = len(Vb)
+    off_s = off_t + len(Vt)
+    V = np.vstack([Vb, Vt] + rows)
+    ring_index = [rb] + [off_s + (j - 1) * n + np.arange(n) for j in range(1, m)] + [off_t + rt]
+    quads = []
+    for lo, hi in zip(ring_index[:-1], ring_index[1:]):
+        a, b = lo, np.roll(lo, -1)
+        c, d = np.roll(hi, -1), hi
+        quads.append(np.column_stack([a, b, c]))
+        quads.append(np.column_stack([a, c, d]))
+    F = np.vstack([Fb, Ft + off_t] + quads).astype(np.int64)
+    on_side = np.zeros(len(V), dtype=bool)
+    on_side[np.concatenate(ring_index)] = True
+    for _ in range(levels):
+        V, F, on_side = _subdivide(V, F, on_side, R)
+    return V, F, on_side
