@@ -784,7 +784,7 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
         from .features import feature_principal_curvature
         return feature_principal_curvature(
             mesh, None, radius, feature_angle=feature_angle, boundary=boundary, solver=solver, rtol=rtol,
-            _data=(boundary_normals, boundary_shape_operator, simply_supported)).as_tuple()
+            _data=(boundary_normals, boundary_shape_operator, simply_supported), _dropin=True)
     boundary_normals, treatment = _resolve_boundary(mesh, boundary, boundary_normals,
                                                     boundary_shape_operator)
     rtol = _check_rtol(rtol)

@@ -113,7 +113,8 @@ def _edge_index(mesh, pairs, name):
 
 
 def crease_edges(mesh: TriangleMesh, feature_angle: float | None = DEFAULT_FEATURE_ANGLE, *,
-                 edges: ArrayLike | None = None) -> NDArray[np.bool_]:
+                 edges: ArrayLike | None = None, theta: NDArray[np.float64] | None = None
+                 ) -> NDArray[np.bool_]:
     """Which edges are creases.
 
     Parameters
@@ -125,6 +126,7 @@ def crease_edges(mesh: TriangleMesh, feature_angle: float | None = DEFAULT_FEATU
     edges : (k, 2) array_like of int, optional
         Crease edges named by their vertex pairs (either order), added to the detected
         ones.  Boundary edges are refused (they are already boundary).
+    theta : (#E,) float64, optional, :func:`dihedral_angles` if already computed.
 
     Returns
     -------
@@ -133,7 +135,7 @@ def crease_edges(mesh: TriangleMesh, feature_angle: float | None = DEFAULT_FEATU
     crease = np.zeros(mesh.n_edges, dtype=bool)
     if feature_angle is not None:
         a = np.radians(check_feature_angle(feature_angle))
-        crease |= np.abs(dihedral_angles(mesh)) > a
+        crease |= np.abs(dihedral_angles(mesh) if theta is None else theta) > a
     if edges is not None:
         idx = _edge_index(mesh, edges, "crease_edges")
         bnd = mesh.boundary_edges[idx]
@@ -189,8 +191,10 @@ class CreaseNetwork:
         return np.bincount(self.chain, weights=self.theta * self.length, minlength=self.n_chains)
 
 
-def crease_network(mesh: TriangleMesh, crease: NDArray[np.bool_]) -> CreaseNetwork:
-    """Chains, corners and line measure of the crease edges ``crease`` ((#E,) bool)."""
+def crease_network(mesh: TriangleMesh, crease: NDArray[np.bool_],
+                   theta: NDArray[np.float64] | None = None) -> CreaseNetwork:
+    """Chains, corners and line measure of the crease edges ``crease`` ((#E,) bool);
+    ``theta``: :func:`dihedral_angles` if already computed."""
     idx = np.flatnonzero(crease)
     E = mesh.edges[idx]
     nV = mesh.n_vertices
@@ -207,7 +211,7 @@ def crease_network(mesh: TriangleMesh, crease: NDArray[np.bool_]) -> CreaseNetwo
         _, chain = sp.csgraph.connected_components(A, directed=False)
     else:
         chain = np.zeros(0, dtype=np.int64)
-    theta = dihedral_angles(mesh)[idx]
+    theta = (dihedral_angles(mesh) if theta is None else theta)[idx]
     return CreaseNetwork(edge_index=idx, edges=E, theta=theta,
                          length=mesh.unique_edge_lengths[idx], chain=chain.astype(np.int64),
                          corners=np.flatnonzero(deg >= 3), endpoints=np.flatnonzero(deg == 1))
@@ -294,9 +298,10 @@ def _prepare(V, F, feature_angle, crease_edges_, boundary, data):
     if boundary != "estimate":
         raise ValueError(f"feature_angle / crease_edges need boundary='estimate' (each side of a crease "
                          f"is clamped with its estimated normals), got boundary={boundary!r}")
-    crease = crease_edges(mesh, feature_angle, edges=crease_edges_)
+    theta = dihedral_angles(mesh)
+    crease = crease_edges(mesh, feature_angle, edges=crease_edges_, theta=theta)
     cut, cm = _cut_mesh(mesh, crease)
-    return mesh, crease, cut, cm
+    return mesh, (crease, theta), cut, cm
 
 
 def feature_shape_operator(V: Any, F: ArrayLike | None = None, *,
@@ -367,7 +372,7 @@ def feature_principal_curvature(V: Any, F: ArrayLike | None = None, radius: int 
                                 feature_angle: float | None = DEFAULT_FEATURE_ANGLE,
                                 crease_edges: ArrayLike | None = None, boundary: str = "estimate",
                                 solver: str = "auto", rtol: float | None = None,
-                                _data=()) -> FeatureCurvature:
+                                _data=(), _dropin=False) -> FeatureCurvature | tuple:
     """Principal curvatures of the smooth parts of a creased surface, per side.
 
     :func:`feature_shape_operator`, then the drop-in's vertex stage
@@ -388,11 +393,24 @@ def feature_principal_curvature(V: Any, F: ArrayLike | None = None, radius: int 
     Returns
     -------
     FeatureCurvature
+
+    Examples
+    --------
+    >>> import igl_hhj.features as ft
+    >>> from igl_hhj.surfaces.creased import capped_cylinder
+    >>> V, F, _ = capped_cylinder(2)            # R = 1: H = 1/2 on the side, 0 on the caps
+    >>> r = ft.feature_principal_curvature(V, F)
+    >>> r.creases.n_chains, len(r.creases.corners)   # the two rims, no corners
+    (2, 0)
+    >>> rim = r.creases.edges[0, 0]                  # a rim vertex has two sides
+    >>> sides = (r.side_parent == rim).nonzero()[0]
+    >>> sorted(round(float(h), 2) for h in r.side_mean_curvature[sides])
+    [0.0, 0.5]
     """
     from . import curvature
     from .solvers import DEFAULT_RTOL
     curvature.check_principal_curvature_args(radius, True)
-    mesh, crease, cut, cm = _prepare(V, F, feature_angle, crease_edges, boundary, _data)
+    mesh, (crease, theta), cut, cm = _prepare(V, F, feature_angle, crease_edges, boundary, _data)
     rtol = curvature._check_rtol(DEFAULT_RTOL if rtol is None else rtol)
     bn, treatment = curvature._resolve_boundary(cm, "estimate", None, None)
     S = curvature._shape_operator(cm, bn, None, None, solver, rtol, estimated=treatment == "estimate")
@@ -401,8 +419,11 @@ def feature_principal_curvature(V: Any, F: ArrayLike | None = None, radius: int 
     sPD1, sPD2, sPV1, sPV2, sbad = curvature.dropin_vertex_values(cm, holder, radius, rtol)
     nV = mesh.n_vertices
     bad = [b for b in sbad if b < nV]
+    if _dropin:          # the drop-in's tuple only (no crease network)
+        return (np.ascontiguousarray(sPD1[:nV]), np.ascontiguousarray(sPD2[:nV]),
+                np.ascontiguousarray(sPV1[:nV]), np.ascontiguousarray(sPV2[:nV]), bad)
     return FeatureCurvature(
         PD1=np.ascontiguousarray(sPD1[:nV]), PD2=np.ascontiguousarray(sPD2[:nV]),
         PV1=np.ascontiguousarray(sPV1[:nV]), PV2=np.ascontiguousarray(sPV2[:nV]), bad_vertices=bad,
         side_PD1=sPD1, side_PD2=sPD2, side_PV1=sPV1, side_PV2=sPV2, side_parent=cut.parent,
-        side_normals=cm.vertex_normals, cut=cut, creases=crease_network(mesh, crease))
+        side_normals=cm.vertex_normals, cut=cut, creases=crease_network(mesh, crease, theta))
