@@ -253,3 +253,28 @@ def test_fandisk_face_saw_tooth_is_gone():
     s_off, a_off = jumps(igl_hhj.shape_operator(V, F))
     assert s_on <= 1.25 * a_on, f"features on: strip {s_on:.3f}, away {a_on:.3f}"
     assert s_off >= 4 * a_off, f"features off: strip {s_off:.3f}, away {a_off:.3f}"
+
+
+def test_cli_and_batch_feature_angle(tmp_path, capsys):
+    from igl_hhj import batch, cli
+    V, F, _ = capped_cylinder(1)
+    path = tmp_path / "capped.off"
+    igl.write_triangle_mesh(str(path), V, F)
+    V, F = igl.read_triangle_mesh(str(path))                # what the CLI reads
+    ref = igl_hhj.principal_curvature(V, F, feature_angle=40)
+    out = tmp_path / "c.npz"
+    assert cli.main(["curvature", str(path), "--feature-angle", "40", "-o", str(out)]) == 0
+    said = capsys.readouterr().out
+    assert "creases (--feature-angle 40): 72 edges in 2 chains, 0 corners" in said
+    with np.load(out) as z:
+        np.testing.assert_array_equal(z["k1"], ref[2])
+        np.testing.assert_array_equal(z["S"], igl_hhj.shape_operator(V, F, feature_angle=40))
+    res = batch.run_batch([path], tmp_path / "b", workers=0, progress=False, feature_angle=40)
+    assert res.counts()["ok"] == 1
+    with np.load(tmp_path / "b" / "capped.npz") as z:
+        np.testing.assert_array_equal(z["k1"], ref[2])
+    assert batch.options_key("hhj", "vertex", None) == {"method": "hhj", "per": "vertex", "radius": 5}
+    for argv in (["--feature-angle", "200"], ["--feature-angle", "40", "--method", "igl"],
+                 ["--feature-angle", "40", "--per", "face", "--radius", "2"]):
+        assert cli.main(["curvature", str(path)] + argv) == 2
+        assert "feature-angle" in capsys.readouterr().err
