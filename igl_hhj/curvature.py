@@ -728,7 +728,7 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
         crease and no value is averaged across it
         (:func:`igl_hhj.features.feature_principal_curvature`).  A crease vertex gets
         the values of its side with the largest incident area; the per-side values and
-        the crease's own line measure θ_e|e| are in the richer
+        the crease's own line measure θ_e ℓ_e are in the richer
         :func:`igl_hhj.features.feature_principal_curvature`.  Only with
         ``boundary="estimate"`` and without boundary data.
 
@@ -781,10 +781,10 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
             kw["feature_angle"] = feature_angle
         return repaired_principal_curvature(principal_curvature, exc, V, F, radius, useKring, kw)
     if feature_angle is not None:
-        from .features import feature_principal_curvature
-        return feature_principal_curvature(
-            mesh, None, radius, feature_angle=feature_angle, boundary=boundary, solver=solver, rtol=rtol,
-            _data=(boundary_normals, boundary_shape_operator, simply_supported), _dropin=True)
+        from .features import _feature_dropin
+        return _feature_dropin(mesh, None, radius, feature_angle=feature_angle, boundary=boundary,
+                              solver=solver, rtol=rtol,
+                              data=(boundary_normals, boundary_shape_operator, simply_supported))
     boundary_normals, treatment = _resolve_boundary(mesh, boundary, boundary_normals,
                                                     boundary_shape_operator)
     rtol = _check_rtol(rtol)

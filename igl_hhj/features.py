@@ -15,7 +15,7 @@ This module treats the surface as **cut along its creases** (issue 27):
   edges the caller names.
 * :func:`crease_network`: chains (maximal runs of crease edges through vertices of
   crease degree 2), corners (≥ 3 creases meet) and end points (1 crease), the
-  per-edge angle θ_e, length |e| and the mean-curvature line measure θ_e|e|/2.
+  per-edge angle θ_e, length ℓ_e and the mean-curvature line measure θ_e ℓ_e / 2.
 * :func:`cut_along`: the mesh with every vertex duplicated once per *side* (the
   components of its star connected across non-crease edges).  Faces keep their
   order and their corner order (only the indices change); the crease edges become
@@ -157,7 +157,7 @@ class CreaseNetwork:
     edge_index : (#C,) int64, the crease edges' indices into ``mesh.edges``.
     edges : (#C, 2) int64, their vertex pairs (``mesh.edges`` rows).
     theta : (#C,) float64, signed dihedral angle θ_e in radians (+ convex).
-    length : (#C,) float64, |e|.
+    length : (#C,) float64, ℓ_e, the edge length.
     chain : (#C,) int64, chain label 0..n_chains-1: maximal runs of crease edges through
         vertices of crease degree 2 (closed loops included).
     corners : (k,) int64, vertices where ≥ 3 crease edges meet.
@@ -178,17 +178,18 @@ class CreaseNetwork:
 
     @property
     def mean_curvature_measure(self) -> NDArray[np.float64]:
-        """(#C,) θ_e|e|/2: the mean curvature measure ∫ H dA carried by each crease edge."""
+        """(#C,) θ_e ℓ_e / 2: the mean curvature measure ∫ H dA carried by each crease edge."""
         return 0.5 * self.theta * self.length
 
     @property
     def total_angle_length(self) -> float:
-        """Σ θ_e |e|: converges to ∫_crease θ ds on the exact surface."""
+        """Σ θ_e ℓ_e: converges to ∫_crease θ ds on the exact surface."""
         return float(np.sum(self.theta * self.length))
 
     def chain_totals(self) -> NDArray[np.float64]:
-        """(n_chains,) Σ θ_e |e| per chain."""
-        return np.bincount(self.chain, weights=self.theta * self.length, minlength=self.n_chains)
+        """(n_chains,) Σ θ_e ℓ_e per chain."""
+        return np.asarray(np.bincount(self.chain, weights=self.theta * self.length, minlength=self.n_chains),
+                          dtype=np.float64)
 
 
 def crease_network(mesh: TriangleMesh, crease: NDArray[np.bool_],
@@ -372,7 +373,7 @@ def feature_principal_curvature(V: Any, F: ArrayLike | None = None, radius: int 
                                 feature_angle: float | None = DEFAULT_FEATURE_ANGLE,
                                 crease_edges: ArrayLike | None = None, boundary: str = "estimate",
                                 solver: str = "auto", rtol: float | None = None,
-                                _data=(), _dropin=False) -> FeatureCurvature | tuple:
+                                _data=()) -> FeatureCurvature:
     """Principal curvatures of the smooth parts of a creased surface, per side.
 
     :func:`feature_shape_operator`, then the drop-in's vertex stage
@@ -407,23 +408,39 @@ def feature_principal_curvature(V: Any, F: ArrayLike | None = None, radius: int 
     >>> sorted(round(abs(float(h)), 1) for h in r.side_mean_curvature[sides])
     [0.0, 0.5]
     """
-    from . import curvature
-    from .solvers import DEFAULT_RTOL
-    curvature.check_principal_curvature_args(radius, True)
-    mesh, (crease, theta), cut, cm = _prepare(V, F, feature_angle, crease_edges, boundary, _data)
-    rtol = curvature._check_rtol(DEFAULT_RTOL if rtol is None else rtol)
-    bn, treatment = curvature._resolve_boundary(cm, "estimate", None, None)
-    S = curvature._shape_operator(cm, bn, None, None, solver, rtol, estimated=treatment == "estimate")
-    holder = [S]
-    del S
-    sPD1, sPD2, sPV1, sPV2, sbad = curvature.dropin_vertex_values(cm, holder, radius, rtol)
+    mesh, (crease, theta), cut, cm, (sPD1, sPD2, sPV1, sPV2, sbad) = _side_values(
+        V, F, radius, feature_angle, crease_edges, boundary, solver, rtol, _data)
     nV = mesh.n_vertices
     bad = [b for b in sbad if b < nV]
-    if _dropin:          # the drop-in's tuple only (no crease network)
-        return (np.ascontiguousarray(sPD1[:nV]), np.ascontiguousarray(sPD2[:nV]),
-                np.ascontiguousarray(sPV1[:nV]), np.ascontiguousarray(sPV2[:nV]), bad)
     return FeatureCurvature(
         PD1=np.ascontiguousarray(sPD1[:nV]), PD2=np.ascontiguousarray(sPD2[:nV]),
         PV1=np.ascontiguousarray(sPV1[:nV]), PV2=np.ascontiguousarray(sPV2[:nV]), bad_vertices=bad,
         side_PD1=sPD1, side_PD2=sPD2, side_PV1=sPV1, side_PV2=sPV2, side_parent=cut.parent,
         side_normals=cm.vertex_normals, cut=cut, creases=crease_network(mesh, crease, theta))
+
+
+def _side_values(V, F, radius, feature_angle, crease_edges, boundary, solver, rtol, data):
+    """The drop-in's pipeline on the cut mesh: per-side (PD1, PD2, PV1, PV2, bad)."""
+    from . import curvature
+    from .solvers import DEFAULT_RTOL
+    curvature.check_principal_curvature_args(radius, True)
+    mesh, ct, cut, cm = _prepare(V, F, feature_angle, crease_edges, boundary, data)
+    rtol = curvature._check_rtol(DEFAULT_RTOL if rtol is None else rtol)
+    bn, treatment = curvature._resolve_boundary(cm, "estimate", None, None)
+    S = curvature._shape_operator(cm, bn, None, None, solver, rtol, estimated=treatment == "estimate")
+    holder = [S]
+    del S
+    return mesh, ct, cut, cm, curvature.dropin_vertex_values(cm, holder, radius, rtol)
+
+
+def _feature_dropin(V: Any, F: ArrayLike | None, radius: int, *, feature_angle: float | None,
+                   boundary: str = "estimate", solver: str = "auto", rtol: float | None = None,
+                   data=()) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
+                                     NDArray[np.float64], list[int]]:
+    """``principal_curvature(..., feature_angle=...)``: the primary sides' values only
+    (:func:`feature_principal_curvature` without the crease network)."""
+    mesh, _, _, _, (PD1, PD2, PV1, PV2, bad) = _side_values(
+        V, F, radius, feature_angle, None, boundary, solver, rtol, data)
+    nV = mesh.n_vertices
+    return (np.ascontiguousarray(PD1[:nV]), np.ascontiguousarray(PD2[:nV]),
+            np.ascontiguousarray(PV1[:nV]), np.ascontiguousarray(PV2[:nV]), [b for b in bad if b < nV])

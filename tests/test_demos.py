@@ -25,7 +25,8 @@ import pytest
 from conftest import MESH_DIR, png_stats, require_egl
 
 ROOT = Path(__file__).resolve().parents[1]
-DEMOS = ["quickstart", "compare_curvature", "refinement", "boundary_data", "biharmonic", "regge", "curved"]
+DEMOS = ["quickstart", "compare_curvature", "refinement", "boundary_data", "biharmonic", "regge", "curved",
+         "features"]
 SIZE = (320, 200)
 MIN_STD = 0.03        # flat white: 0.0; real demo pictures: >= 0.10
 MIN_DRAWN = 0.10      # fraction of pixels that differ from the background
