@@ -233,3 +233,18 @@ def test_quickstart_creates_its_out_dir(tmp_path):
     (tmp_path / "file").write_text("x")
     res = run(["demos/quickstart.py", "--out-dir", str(tmp_path / "file"), "--no-screenshot"], timeout=60)
     assert res.returncode == 2 and "is a file, not a folder" in res.stderr
+
+
+def test_features_demo(tmp_path, requires_egl):
+    import igl
+
+    from igl_hhj.surfaces.creased import capped_cylinder
+    V, F, _ = capped_cylinder(2)
+    path = tmp_path / "capped.off"
+    igl.write_triangle_mesh(str(path), V, F)
+    out = run_demo("features", tmp_path, str(path))
+    header, body = table_rows(out, "Creases above 40 degrees")
+    assert [int(c) for c in body[0][:4]] == [144, 2, 0, 0]          # the two rims
+    header, body = table_rows(out, "saw-tooth")
+    saw = {r[0]: number(r[2]) for r in body}
+    assert saw["HHJ without features (vertex)"] > 4 * saw["HHJ with features (vertex)"], saw
