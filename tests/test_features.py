@@ -17,7 +17,7 @@ from igl_hhj import features as ft
 from igl_hhj import intrinsic, recovery
 from igl_hhj.convergence import eoc
 from igl_hhj.mesh import as_mesh
-from igl_hhj.surfaces.creased import CappedCylinder, capped_cylinder
+from igl_hhj.surfaces.creased import CappedCylinder, HalfEllipsoid, capped_cylinder, half_ellipsoid
 
 FANDISK = MESH_DIR / "fandisk.off"
 
@@ -39,19 +39,34 @@ def ring_distance(mesh, seeds, max_rings):
 
 
 def side_exact_H(surface, cut, face_normals):
-    """Exact H of every cut vertex: the side of its faces (each side lies in one patch)."""
-    Hf = surface.mean_curvature_of_faces(face_normals)
-    out = np.zeros(len(cut.V))
-    np.maximum.at(out, cut.F.ravel(), np.repeat(Hf, 3))     # 0 on caps, 1/(2R) on the side
+    """Exact H of every cut vertex, from the patch its faces lie on (each side of a crease
+    vertex lies in one patch): the capped cylinder's side / caps, or the half ellipsoid's
+    dome (H of the ellipsoid at the vertex) / flat bottom."""
+    if isinstance(surface, CappedCylinder):
+        flat = np.abs(face_normals[:, 2]) > 0.5
+        return np.where(_on_faces(cut, flat), 0.0, surface.side_mean_curvature())
+    flat = face_normals[:, 2] < -0.5
+    return surface.mean_curvature_at(cut.V, _on_faces(cut, flat))
+
+
+def _on_faces(cut, face_mask):
+    """(#Vc,) bool: cut vertices with an incident face in ``face_mask``."""
+    out = np.zeros(len(cut.V), dtype=bool)
+    out[cut.F[face_mask].ravel()] = True
     return out
 
 
-@pytest.fixture(scope="module")
-def cylinder_study():
-    s = CappedCylinder()
+SURFACES = {"capped cylinder": (CappedCylinder, capped_cylinder),
+            "half ellipsoid": (HalfEllipsoid, half_ellipsoid)}
+
+
+@pytest.fixture(scope="module", params=list(SURFACES))
+def crease_study(request):
+    make_surface, make_mesh = SURFACES[request.param]
+    s = make_surface()
     rows = []
     for level in range(1, 5):
-        V, F, _ = capped_cylinder(level)
+        V, F, _ = make_mesh(level)
         mesh = as_mesh(V, F)
         on = ft.feature_principal_curvature(V, F)
         _, _, PV1, PV2, _ = igl_hhj.principal_curvature(V, F)
@@ -60,29 +75,30 @@ def cylinder_study():
         err_on = np.abs(on.side_mean_curvature - Hex)[band[on.side_parent]].max()
         err_off = np.abs(0.5 * (PV1 + PV2) - Hex[:len(V)])[band].max()
         rows.append((mesh.edge_lengths.max(), err_on, err_off, on.creases.total_angle_length,
-                     on.creases.n_chains, len(on.creases.corners)))
-    return s, np.array(rows)
+                     on.creases.n_chains, len(on.creases.corners), np.abs(Hex).max()))
+    return request.param, s, np.array(rows)
 
 
-def test_band_converges_with_features_and_not_without(cylinder_study):
-    s, rows = cylinder_study
-    hs, on, off = rows[:, 0], rows[:, 1], rows[:, 2]
+def test_band_converges_with_features_and_not_without(crease_study):
+    name, s, rows = crease_study
+    hs, on, off, Hmax = rows[:, 0], rows[:, 1], rows[:, 2], rows[-1, 6]
     r_on, r_off = eoc(on, hs), eoc(off, hs)
-    assert (r_on >= 0.9).all(), f"features on, band EOCs {np.round(r_on, 3)} (errors {on})"
-    assert on[-1] < 0.02 * s.side_mean_curvature(), f"finest band error {on[-1]:.3g}"
+    assert (r_on >= 0.9).all(), f"{name}, features on, band EOCs {np.round(r_on, 3)} (errors {on})"
+    assert on[-1] < 0.02 * Hmax, f"{name}: finest band error {on[-1]:.3g}"
     # without features the rim's Dirac measure is smeared into the band: no convergence
-    assert (r_off <= 0).all(), f"features off, band EOCs {np.round(r_off, 3)} (errors {off})"
-    assert off[-1] > s.side_mean_curvature(), f"features off, finest band error {off[-1]:.3g}"
+    assert (r_off <= 0).all(), f"{name}, features off, band EOCs {np.round(r_off, 3)} (errors {off})"
+    assert off[-1] > Hmax, f"{name}, features off, finest band error {off[-1]:.3g}"
 
 
-def test_crease_line_measure_converges(cylinder_study):
-    s, rows = cylinder_study
+def test_crease_line_measure_converges(crease_study):
+    name, s, rows = crease_study
     hs, total = rows[:, 0], rows[:, 3]
     err = np.abs(total - s.crease_integral)
     r = eoc(err, hs)
-    assert (r >= 0.9).all(), f"Σθ|e| EOCs {np.round(r, 3)} (errors {err})"
-    assert err[-1] < 0.01 * s.crease_integral
-    assert (rows[:, 4] == 2).all() and (rows[:, 5] == 0).all()      # two rims, no corners
+    assert (r >= 0.9).all(), f"{name}: Σθ|e| EOCs {np.round(r, 3)} (errors {err})"
+    assert err[-1] < 0.02 * s.crease_integral
+    rims = 2 if name == "capped cylinder" else 1
+    assert (rows[:, 4] == rims).all() and (rows[:, 5] == 0).all()      # the rims, no corners
 
 
 def test_shape_operator_with_features_is_flat_on_the_caps():

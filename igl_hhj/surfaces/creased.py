@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["capped_cylinder", "CappedCylinder"]
+__all__ = ["capped_cylinder", "CappedCylinder", "half_ellipsoid", "HalfEllipsoid"]
 
 
 class CappedCylinder:
@@ -110,3 +110,69 @@ def capped_cylinder(levels=0, rings=3, amount=0.25, seed=0, radius=1.0, height=1
     for _ in range(levels):
         V, F, on_side = _subdivide(V, F, on_side, R)
     return V, F, on_side
+
+
+class HalfEllipsoid:
+    """The upper half ``z ≥ 0`` of the ellipsoid ``(x/a)² + (y/b)² + (z/c)² = 1`` closed by
+    the flat ellipse ``z = 0``: a closed surface whose curved part has varying curvature,
+    with one convex crease, the rim ellipse, of dihedral angle π/2 everywhere (the
+    ellipsoid's normal is horizontal at z = 0)."""
+
+    def __init__(self, axes=(1.0, 0.7, 0.8)):
+        from .exact import Ellipsoid
+        self.ellipsoid = Ellipsoid(axes)
+        self.axes = self.ellipsoid.axes
+
+    @property
+    def crease_integral(self):
+        """∫_crease θ ds = (π/2) × the ellipse's perimeter (numerical quadrature)."""
+        a, b = self.axes[:2]
+        t = np.linspace(0.0, 2 * np.pi, 200001)
+        speed = np.hypot(a * np.sin(t), b * np.cos(t))
+        return 0.5 * np.pi * float(np.sum(0.5 * (speed[1:] + speed[:-1]) * np.diff(t)))
+
+    def mean_curvature_of_faces(self, face_normals, face_centres):
+        """(#F,) exact H of the patch a face lies on, at the face's centre projected onto it:
+        0 on the flat bottom (ν_z < -1/2), the ellipsoid's H elsewhere."""
+        X = self.ellipsoid.project(face_centres)
+        return np.where(face_normals[:, 2] < -0.5, 0.0, self.ellipsoid.mean_curvature(X))
+
+    def mean_curvature_at(self, X, on_bottom):
+        """(n,) exact H at points ``X`` of the surface: 0 where ``on_bottom``."""
+        return np.where(on_bottom, 0.0, self.ellipsoid.mean_curvature(X))
+
+
+def half_ellipsoid(levels=0, rings=3, amount=0.25, seed=0, axes=(1.0, 0.7, 0.8)):
+    """Non-uniform closed mesh of :class:`HalfEllipsoid`, outward normals.
+
+    One jittered Delaunay disc (:func:`igl_hhj.surfaces.biharmonic_problems.disk_mesh`,
+    ``levels`` refinements, boundary on the circle) mapped twice: onto the dome by
+    ``(r, φ) ↦ (a sin θ cos φ, b sin θ sin φ, c cos θ)``, θ = πr/2, and onto the bottom by
+    ``(r, φ) ↦ (a r cos φ, b r sin φ, 0)``; the two rims coincide and are shared.
+
+    Returns
+    -------
+    V : (#V, 3) float64, F : (#F, 3) int64, on_bottom : (#V,) bool (bottom vertices, rim included)
+    """
+    from .biharmonic_problems import disk_mesh
+    from .meshing import boundary_vertex_mask
+    a, b, c = (float(x) for x in axes)
+    P, Fd = disk_mesh(levels, rings, amount, seed)
+    r = np.minimum(np.hypot(P[:, 0], P[:, 1]), 1.0)
+    phi = np.arctan2(P[:, 1], P[:, 0])
+    rim = boundary_vertex_mask(Fd, len(P))
+    r[rim] = 1.0
+    th = 0.5 * np.pi * r
+    top = np.column_stack([a * np.sin(th) * np.cos(phi), b * np.sin(th) * np.sin(phi), c * np.cos(th)])
+    top[rim, 2] = 0.0
+    inner = np.flatnonzero(~rim)
+    bottom = np.column_stack([a * r[inner] * np.cos(phi[inner]), b * r[inner] * np.sin(phi[inner]),
+                              np.zeros(len(inner))])
+    index = np.arange(len(P))
+    index[inner] = len(P) + np.arange(len(inner))
+    V = np.vstack([top, bottom])
+    F = np.vstack([Fd, index[Fd][:, ::-1]]).astype(np.int64)      # the bottom faces down
+    on_bottom = np.zeros(len(V), dtype=bool)
+    on_bottom[len(P):] = True
+    on_bottom[np.flatnonzero(rim)] = True
+    return V, F, on_bottom
