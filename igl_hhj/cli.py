@@ -323,17 +323,31 @@ def _curvature(args):
         name = Path(args.mesh).stem
         robust = args.robust if args.robust > 0 else None
         shown = dict(estimate=est, name=name, robust=robust, enabled=args.quantity, view=args.camera)
+        def creases():           # --feature-angle: the crease network on the surface, coloured by θ_e
+            if args.feature_angle is None or args.method != "hhj":
+                return []
+            return [viewer.register_creases(mesh.V, mesh.F, feature_angle=args.feature_angle,
+                                            name=f"{name} creases", view=args.camera)]
+
         if args.view:            # first: the interactive window cannot open after an EGL render
             try:
                 viewer.register_curvature(mesh.V, mesh.F, **shown)
+                creases()
                 viewer.show()
             except viewer.ViewerUnavailable as exc:
                 raise UserError(f"cannot open the viewer window: {_first_line(exc)} "
                                 f"(without a display use --screenshot PNG)") from None
         if args.screenshot is not None:
             try:
-                stages.run("screenshot", _quietly, viewer.register_curvature, mesh.V, mesh.F,
-                           screenshot=str(args.screenshot), size=tuple(args.size), **shown)
+                if args.feature_angle is None:
+                    stages.run("screenshot", _quietly, viewer.register_curvature, mesh.V, mesh.F,
+                               screenshot=str(args.screenshot), size=tuple(args.size), **shown)
+                else:
+                    def shot():
+                        viewer.init("openGL3_egl")
+                        regs = [viewer.register_curvature(mesh.V, mesh.F, **shown)] + creases()
+                        viewer.screenshot(str(args.screenshot), regs, size=tuple(args.size))
+                    stages.run("screenshot", _quietly, shot)
             except viewer.ViewerUnavailable as exc:
                 raise UserError(f"no screenshot: {_with_hint(exc)}") from None
             say(f"  wrote {args.screenshot}")

@@ -294,3 +294,31 @@ def test_cli_and_batch_feature_angle(tmp_path, capsys):
                  ["--feature-angle", "40", "--per", "face", "--radius", "2"]):
         assert cli.main(["curvature", str(path)] + argv) == 2
         assert "feature-angle" in capsys.readouterr().err
+
+
+def test_cli_screenshot_draws_the_creases(tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    from conftest import png_stats, require_egl
+    require_egl()
+    V, F, _ = capped_cylinder(1)
+    path = tmp_path / "capped.off"
+    igl.write_triangle_mesh(str(path), V, F)
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    env = dict(os.environ, PYTHONPATH=root + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    pngs = {}
+    for tag, extra in (("off", []), ("on", ["--feature-angle", "40"])):
+        pngs[tag] = tmp_path / f"{tag}.png"
+        res = subprocess.run([sys.executable, "-m", "igl_hhj.cli", "curvature", str(path), "-q",
+                              "--screenshot", str(pngs[tag]), "--size", "400", "300", *extra],
+                             env=env, capture_output=True, text=True, timeout=120)
+        assert res.returncode == 0, res.stderr
+    import matplotlib.image as mpimg
+    assert (png_stats(pngs["on"])["width"], png_stats(pngs["on"])["height"]) == (400, 300)
+    bars = {}
+    for tag, p in pngs.items():                             # the colour-bar strip at the bottom
+        im = mpimg.imread(str(p))[..., :3]
+        bars[tag] = float((im[-40:].min(axis=2) < 0.9).mean())
+    assert bars["on"] > 1.3 * bars["off"], bars             # a second bar: crease angle θ
