@@ -22,7 +22,8 @@ biharmonic solver, also as :func:`biharmonic_solve`), :mod:`igl_hhj.baselines`
 :mod:`igl_hhj.surfaces` (exact test surfaces and mesh sequences), :mod:`igl_hhj.benchmarks`,
 :mod:`igl_hhj.cli` (the ``igl-hhj`` command), :mod:`igl_hhj.recovery` (vertex recovery and
 smoothing scale of the drop-in), :mod:`igl_hhj.boundary_estimation` (data-free boundary normals),
-:mod:`igl_hhj.repair` (the drop-in's repair of meshes the strict functions refuse).
+:mod:`igl_hhj.repair` (the drop-in's repair of meshes the strict functions refuse),
+:mod:`igl_hhj.features` (sharp features: creases as internal boundaries, crease line measure).
 """
 import importlib
 import pkgutil
@@ -38,7 +39,7 @@ __version__ = "0.1.0"
 _LAZY_MODULES = {"regge", "biharmonic", "baselines", "viewer", "surfaces", "benchmarks",
                  "hhj", "mesh", "convergence", "cli", "mesh_io", "mesh_report",
                  "curvature", "errors", "interop", "demos",
-                 "recovery", "boundary_estimation", "repair", "vtk_files", "polygon_io", "batch"}
+                 "recovery", "boundary_estimation", "repair", "vtk_files", "polygon_io", "batch", "features"}
 # The core names resolve on first use too, so that ``import igl_hhj`` (and the
 # ``igl-hhj`` command's start-up, where Ctrl-C must not print a traceback) costs
 # no numpy/scipy import.
@@ -64,7 +65,7 @@ if TYPE_CHECKING:
     # names on first use.  Keep in step with _LAZY_MODULES / _LAZY_ATTRS
     # (tests/test_typing.py checks that the two agree).
     from . import (baselines, batch, benchmarks, biharmonic, boundary_estimation, cli, convergence, curvature,
-                   demos, errors, hhj, interop, mesh, mesh_io, mesh_report, polygon_io, recovery, regge,
+                   demos, errors, features, hhj, interop, mesh, mesh_io, mesh_report, polygon_io, recovery, regge,
                    repair, surfaces, viewer, vtk_files)
     from .biharmonic import BiharmonicSolver, biharmonic_solve
     from .curvature import (boundary_treatment, curvature_of, face_gaussian_curvature,

@@ -120,13 +120,14 @@ MAX_WORKERS = 256
 """Largest ``--radius`` (as :func:`igl_hhj.curvature.check_principal_curvature_args`)."""
 
 
-def check_curvature_options(method, per, radius=None):
+def check_curvature_options(method, per, radius=None, feature_angle=None):
     """Raise ``ValueError`` for a combination ``igl-hhj curvature`` / ``batch`` cannot compute.
 
     ``radius``: hhj per vertex, the smoothing scale of :func:`igl_hhj.principal_curvature`
     (> 0); hhj per face, ``smoothing`` of :func:`igl_hhj.face_principal_curvature` (≥ 0);
     igl, libigl's k-ring (> 0); not for heine.  None: the defaults of
-    :func:`default_radius`."""
+    :func:`default_radius`.  ``feature_angle``: degrees in (0, 180), hhj only (per face
+    only unsmoothed, radius 0), see :mod:`igl_hhj.features`."""
     if method not in METHOD_LABELS:
         raise ValueError(f"unknown method {method!r} (use {', '.join(METHOD_LABELS)})")
     if per not in ("vertex", "face"):
@@ -144,6 +145,17 @@ def check_curvature_options(method, per, radius=None):
                              f"got {radius}")
         if radius > MAX_RADIUS:
             raise ValueError(f"--radius must be at most {MAX_RADIUS} (10**6), got {radius:.3g}")
+    if feature_angle is not None:
+        if method != "hhj":
+            raise ValueError(f"--feature-angle applies to --method hhj, not {method}")
+        if per == "face" and radius:
+            raise ValueError("--feature-angle with --per face gives Walker's S_h of the cut surface "
+                             "unsmoothed: use --radius 0 (or --per vertex)")
+        from .features import check_feature_angle
+        try:
+            check_feature_angle(feature_angle)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"--{exc}".replace("feature_angle", "feature-angle", 1)) from None
 
 
 def default_radius(method, per):
@@ -159,7 +171,7 @@ def _call(label, fn, *args, **kwargs):
 
 
 def compute_curvature(V, F, *, method="hhj", per="vertex", radius=None, keep_shape_operator=False,
-                      run=None):
+                      run=None, feature_angle=None):
     """Curvature of one mesh exactly as ``igl-hhj curvature`` and ``igl-hhj batch`` compute it.
 
     Parameters
@@ -176,6 +188,8 @@ def compute_curvature(V, F, *, method="hhj", per="vertex", radius=None, keep_sha
     run : callable, optional
         ``run(label, fn, *args, **kwargs)`` wraps each stage (the CLI's
         progress lines); default: call ``fn``.
+    feature_angle : float, optional
+        hhj only: sharp features (:mod:`igl_hhj.features`), creases above this many degrees.
 
     Returns
     -------
@@ -183,11 +197,19 @@ def compute_curvature(V, F, *, method="hhj", per="vertex", radius=None, keep_sha
     S : (#F, 3, 3) float64 or None
     """
     from . import baselines
-    check_curvature_options(method, per, radius)
+    check_curvature_options(method, per, radius, feature_angle)
     run = run or _call
     if radius is None:
         radius = default_radius(method, per)
     label = f"{METHOD_LABELS[method]} ({per})"
+    if method == "hhj" and feature_angle is not None:
+        from .curvature import shape_operator
+        hhj = baselines.hhj_face if per == "face" else baselines.hhj_vertex
+        S = run(f"{METHOD_LABELS[method]} (shape operator, creases)", shape_operator, V, F,
+                feature_angle=feature_angle) if keep_shape_operator or per == "face" else None
+        if per == "face":                 # S_h of the cut surface itself
+            return run(f"curvatures ({per})", hhj, V, F, shape_operator=S), S
+        return run(label, hhj, V, F, radius=radius, feature_angle=feature_angle), S
     if method == "hhj":
         hhj = baselines.hhj_face if per == "face" else baselines.hhj_vertex
         scale = {"smoothing": radius} if per == "face" else {"radius": radius}
@@ -266,6 +288,7 @@ class Options:
     fmt: str = "npz"
     timeout: float | None = None
     memory_limit: int | None = None
+    feature_angle: float | None = None
 
     @property
     def sandboxed(self):
@@ -280,17 +303,22 @@ from time ``t`` on (an output newer than ``t`` has them, e.g. one finished by a 
 after an interrupt; an older one still has its previous, unknown options)."""
 
 
-def options_key(method, per, radius):
-    """The options an output depends on (radius None → :func:`default_radius`)."""
-    return {"method": method, "per": per,
-            "radius": default_radius(method, per) if radius is None else int(radius)}
+def options_key(method, per, radius, feature_angle=None):
+    """The options an output depends on (radius None → :func:`default_radius`;
+    ``feature_angle`` only when given, so that older outputs keep their key)."""
+    key = {"method": method, "per": per,
+           "radius": default_radius(method, per) if radius is None else int(radius)}
+    if feature_angle is not None:
+        key["feature_angle"] = float(feature_angle)
+    return key
 
 
 def describe_options(key):
     if key is None:
         return "unknown options"
     text = f"--method {key['method']} --per {key['per']}"
-    return text + (f" --radius {key['radius']}" if key.get("radius") is not None else "")
+    text += f" --radius {key['radius']}" if key.get("radius") is not None else ""
+    return text + (f" --feature-angle {key['feature_angle']:g}" if key.get("feature_angle") is not None else "")
 
 
 def _read_options_file(outdir):
@@ -366,7 +394,8 @@ def _compute_one(job, options, extra):
             raise MeshFileError(f"{job.path}: igl_hhj cannot use this mesh: {exc}") from None
         est, S = compute_curvature(mesh.V, mesh.F, method=options.method, per=options.per,
                                    radius=options.radius,
-                                   keep_shape_operator=options.fmt == "npz")
+                                   keep_shape_operator=options.fmt == "npz",
+                                   feature_angle=options.feature_angle)
         _atomic_write(job.output, options.fmt, mesh.V, mesh.F, est, options.method, S)
         extra.update(_percentile_stats(est))
         status, message = "ok", None
@@ -854,7 +883,7 @@ def _import_distributed():
 
 def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per="vertex",
               radius=None, fmt="npz", resume=True, timeout=None, memory_limit=None, retries=2,
-              group_bytes=GROUP_BYTES, progress=True, stream=None, client=None):
+              group_bytes=GROUP_BYTES, progress=True, stream=None, client=None, feature_angle=None):
     """Curvature of every mesh in ``inputs``; one output per mesh and a summary.
 
     Parameters
@@ -869,7 +898,7 @@ def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per
     workers : int, optional
         Worker processes of the embedded cluster (default: the machine's cores, at most one
         per task); 0: run in this process.  Ignored with ``scheduler``.
-    method, per, radius
+    method, per, radius, feature_angle
         As ``igl-hhj curvature`` (:func:`compute_curvature`).
     fmt : {"npz", "ply", "vtp", "vtu"}
     resume : bool
@@ -894,7 +923,7 @@ def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per
         ``interrupted`` is True after ``KeyboardInterrupt`` (the summary then lists the
         meshes finished so far; rerun to continue).
     """
-    check_curvature_options(method, per, radius)
+    check_curvature_options(method, per, radius, feature_angle)
     if timeout is not None and not timeout > 0:
         raise ValueError(f"timeout must be positive, got {timeout}")
     if memory_limit is not None and not memory_limit > 0:
@@ -909,9 +938,10 @@ def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per
     jobs = plan_jobs(inputs, outdir, fmt)
     if not jobs:
         raise ValueError("no input meshes")
-    options = Options(method, per, None if radius is None else int(radius), fmt, timeout, memory_limit)
+    options = Options(method, per, None if radius is None else int(radius), fmt, timeout, memory_limit,
+                      None if feature_angle is None else float(feature_angle))
     previous = _previous_rows(outdir / "summary.csv")
-    key = options_key(method, per, radius)
+    key = options_key(method, per, radius, feature_angle)
     made = _read_options_file(outdir)
     rel = {job.path: os.path.relpath(job.output, outdir) for job in jobs}
     rows = {}

@@ -256,7 +256,7 @@ def _curvature(args):
 
     per = args.per
     try:
-        check_curvature_options(args.method, per, args.radius)
+        check_curvature_options(args.method, per, args.radius, args.feature_angle)
     except ValueError as exc:
         raise UserError(str(exc)) from None
     if not 0 <= args.robust < 50:
@@ -294,7 +294,8 @@ def _curvature(args):
     t = time.perf_counter()
     est, S = compute_curvature(mesh.V, mesh.F, method=args.method, per=per,
                                radius=args.radius,
-                               keep_shape_operator=keep_S, run=stages.run)
+                               keep_shape_operator=keep_S, run=stages.run,
+                               feature_angle=args.feature_angle)
     dt = time.perf_counter() - t
 
     say(f"{args.mesh}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, "
@@ -306,6 +307,12 @@ def _curvature(args):
         say(f"  smoothing scale (--radius): {radius}" + (" (none: Walker's S_h per face)" if radius == 0 else ""))
         if mesh.has_boundary:
             say("  boundary: clamped with estimated normals (quadric fits; igl_hhj.boundary_estimation)")
+        if args.feature_angle is not None:
+            from .features import crease_edges, crease_network
+            net = crease_network(mesh, crease_edges(mesh, args.feature_angle))
+            say(f"  creases (--feature-angle {args.feature_angle:g}): {len(net.edge_index)} edges in "
+                f"{net.n_chains} chains, {len(net.corners)} corners; cut along them, each side clamped "
+                f"with its own estimated normals; Σ θ_e|e| = {net.total_angle_length:.4g}")
     elif args.method == "igl":
         say(f"  radius: {radius} rings")
     for name, x in [("k1", est.k1), ("k2", est.k2), ("H", est.H), ("K", est.K)]:
@@ -324,17 +331,31 @@ def _curvature(args):
         name = Path(args.mesh).stem
         robust = args.robust if args.robust > 0 else None
         shown = dict(estimate=est, name=name, robust=robust, enabled=args.quantity, view=args.camera)
+        def creases():           # --feature-angle: the crease network on the surface, coloured by θ_e
+            if args.feature_angle is None or args.method != "hhj":
+                return []
+            return [viewer.register_creases(mesh.V, mesh.F, feature_angle=args.feature_angle,
+                                            name=f"{name} creases", view=args.camera)]
+
         if args.view:            # first: the interactive window cannot open after an EGL render
             try:
                 viewer.register_curvature(mesh.V, mesh.F, **shown)
+                creases()
                 viewer.show()
             except viewer.ViewerUnavailable as exc:
                 raise UserError(f"cannot open the viewer window: {_first_line(exc)} "
                                 f"(without a display use --screenshot PNG)") from None
         if args.screenshot is not None:
             try:
-                stages.run("screenshot", _quietly, viewer.register_curvature, mesh.V, mesh.F,
-                           screenshot=str(args.screenshot), size=tuple(args.size), **shown)
+                if args.feature_angle is None:
+                    stages.run("screenshot", _quietly, viewer.register_curvature, mesh.V, mesh.F,
+                               screenshot=str(args.screenshot), size=tuple(args.size), **shown)
+                else:
+                    def shot():
+                        viewer.init("openGL3_egl")
+                        regs = [viewer.register_curvature(mesh.V, mesh.F, **shown)] + creases()
+                        viewer.screenshot(str(args.screenshot), regs, size=tuple(args.size))
+                    stages.run("screenshot", _quietly, shot)
             except viewer.ViewerUnavailable as exc:
                 raise UserError(f"no screenshot: {_with_hint(exc)}") from None
             say(f"  wrote {args.screenshot}")
@@ -399,6 +420,7 @@ def _batch(args):
         result = batch.run_batch(args.inputs, args.out, scheduler=args.scheduler,
                                  workers=args.workers, method=args.method, per=args.per,
                                  radius=args.radius, fmt=args.format, resume=args.resume,
+                                 feature_angle=args.feature_angle,
                                  timeout=args.timeout, memory_limit=args.memory_limit,
                                  progress=not args.quiet,
                                  group_bytes=(batch.GROUP_BYTES if args.group_bytes is None
@@ -409,7 +431,7 @@ def _batch(args):
         raise UserError(f"{args.out}: {exc.strerror or exc}") from None
     for was, n in result.recomputed.items():
         print(f"igl-hhj: recomputed {n} mesh{'es' if n > 1 else ''} whose output had {was} "
-              f"(now {batch.describe_options(batch.options_key(args.method, args.per, args.radius))})",
+              f"(now {batch.describe_options(batch.options_key(args.method, args.per, args.radius, args.feature_angle))})",
               file=sys.stderr)
     c = result.counts()
     of = f" of {result.total}" if len(result.rows) < result.total else ""
@@ -568,6 +590,10 @@ def build_parser():
                    help="scale: for hhj the smoothing length in rings / mean edge lengths "
                         "(default 5 per vertex as igl.principal_curvature, 0 per face: Walker's S_h); "
                         "for igl the k-ring size (default 5)")
+    c.add_argument("--feature-angle", type=float, default=None, metavar="DEG",
+                   help="hhj: sharp features; edges whose normals turn by more than DEG degrees "
+                        "(e.g. 40) are creases: the surface is cut along them and each side gets "
+                        "its own values (default: off, as libigl)")
     c.add_argument("-o", "--out", metavar="OUT",
                    help="output file, by extension: OUT.npz (k1, k2, H, K, d1, d2, V, F, and the "
                         "shape operator S for hhj), OUT.csv (one row per vertex or face), OUT.ply "
@@ -614,6 +640,8 @@ def build_parser():
                    help="as for 'igl-hhj curvature' (default vertex)")
     b.add_argument("--radius", type=int, metavar="R",
                    help="as for 'igl-hhj curvature': hhj smoothing scale (default 5 per vertex, 0 per face), igl k-ring")
+    b.add_argument("--feature-angle", type=float, default=None, metavar="DEG",
+                   help="as for 'igl-hhj curvature': hhj with creases above DEG degrees (default off)")
     b.add_argument("--format", choices=list(batch_formats()), default="npz",
                    help="npz (default; same content as 'igl-hhj curvature -o X.npz'), ply, or "
                         "vtp / vtu (ParaView, pyvista)")

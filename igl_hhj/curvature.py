@@ -285,7 +285,8 @@ def _check_rtol(rtol):
 def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary: str = "estimate",
                    boundary_normals: ArrayLike | None = None,
                    boundary_shape_operator: ArrayLike | None = None, simply_supported: ArrayLike | None = None,
-                   solver: str = "auto", rtol: float = DEFAULT_RTOL, repair: bool = False) -> NDArray[np.float64]:
+                   solver: str = "auto", rtol: float = DEFAULT_RTOL, repair: bool = False,
+                   feature_angle: float | None = None) -> NDArray[np.float64]:
     """Walker's HHJ approximation S_h of the shape operator ∇_Γν, one tensor per face.
 
     Solves ``A s^k = -B X^k + g^k`` for the three coordinate functions
@@ -333,6 +334,11 @@ def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary: str = "estim
         corners) is repaired as in :func:`principal_curvature` (one
         :class:`~igl_hhj.mesh.MeshWarning`); rows of dropped faces are NaN,
         in the caller's F order.  False: such meshes raise ``ValueError``.
+    feature_angle : float, optional (default None: off)
+        Cut the surface along the edges whose dihedral angle exceeds ``feature_angle``
+        degrees and clamp each side with its own estimated normals
+        (:func:`igl_hhj.features.feature_shape_operator`); the creases' curvature (a
+        line measure) is then not in S_h but in :func:`igl_hhj.features.crease_network`.
 
     Returns
     -------
@@ -370,10 +376,16 @@ def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary: str = "estim
         if not repair:
             raise
         from .repair import repaired_shape_operator
-        return repaired_shape_operator(shape_operator, exc, V, F, dict(
-            boundary=boundary, boundary_normals=boundary_normals,
-            boundary_shape_operator=boundary_shape_operator, simply_supported=simply_supported,
-            solver=solver, rtol=rtol))
+        kw = dict(boundary=boundary, boundary_normals=boundary_normals,
+                  boundary_shape_operator=boundary_shape_operator, simply_supported=simply_supported,
+                  solver=solver, rtol=rtol)
+        if feature_angle is not None:
+            kw["feature_angle"] = feature_angle
+        return repaired_shape_operator(shape_operator, exc, V, F, kw)
+    if feature_angle is not None:
+        from .features import _prepare
+        _, _, _, mesh = _prepare(mesh, None, feature_angle, None, boundary,
+                                 (boundary_normals, boundary_shape_operator, simply_supported))
     boundary_normals, treatment = _resolve_boundary(mesh, boundary, boundary_normals,
                                                     boundary_shape_operator)
     S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver,
@@ -676,7 +688,8 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
                         boundary: str = "estimate",
                         boundary_normals: ArrayLike | None = None, boundary_shape_operator: ArrayLike | None = None,
                         simply_supported: ArrayLike | None = None, solver: str = "auto",
-                        rtol: float = DEFAULT_RTOL) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
+                        rtol: float = DEFAULT_RTOL, feature_angle: float | None = None
+                        ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
                                    list[int]]:
     """Drop-in replacement for ``igl.principal_curvature`` (libigl ≥ 2.5.4 / 2.6).
 
@@ -708,6 +721,16 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
         :func:`shape_operator`).
     boundary_normals, boundary_shape_operator, simply_supported, solver, rtol
         Keyword-only extras, see :func:`shape_operator`.
+    feature_angle : float, optional (keyword-only; default None: off, libigl's contract)
+        Sharp features (issue 27): edges whose dihedral angle exceeds ``feature_angle``
+        degrees are creases; the surface is cut along them and each side is clamped
+        with its own one-sided normals, so that the smooth parts converge up to the
+        crease and no value is averaged across it
+        (:func:`igl_hhj.features.feature_principal_curvature`).  A crease vertex gets
+        the values of its side with the largest incident area; the per-side values and
+        the crease's own line measure θ_e ℓ_e are in the richer
+        :func:`igl_hhj.features.feature_principal_curvature`.  Only with
+        ``boundary="estimate"`` and without boundary data.
 
     Returns
     -------
@@ -751,10 +774,17 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
         mesh = as_mesh(V, F)
     except MeshDefectError as exc:       # repairable defect: repair, compute, map back (issue 24)
         from .repair import repaired_principal_curvature
-        return repaired_principal_curvature(principal_curvature, exc, V, F, radius, useKring, dict(
-            boundary=boundary, boundary_normals=boundary_normals,
-            boundary_shape_operator=boundary_shape_operator, simply_supported=simply_supported,
-            solver=solver, rtol=rtol))
+        kw = dict(boundary=boundary, boundary_normals=boundary_normals,
+                  boundary_shape_operator=boundary_shape_operator, simply_supported=simply_supported,
+                  solver=solver, rtol=rtol)
+        if feature_angle is not None:
+            kw["feature_angle"] = feature_angle
+        return repaired_principal_curvature(principal_curvature, exc, V, F, radius, useKring, kw)
+    if feature_angle is not None:
+        from .features import _feature_dropin
+        return _feature_dropin(mesh, None, radius, feature_angle=feature_angle, boundary=boundary,
+                              solver=solver, rtol=rtol,
+                              data=(boundary_normals, boundary_shape_operator, simply_supported))
     boundary_normals, treatment = _resolve_boundary(mesh, boundary, boundary_normals,
                                                     boundary_shape_operator)
     rtol = _check_rtol(rtol)

@@ -60,7 +60,7 @@ __all__ = [
     "ViewerUnavailable", "QuantityInfo", "Registration", "QUANTITIES", "METHODS",
     "init", "show", "color_range", "curvature_estimate", "local_edge_length",
     "register_curvature", "register_comparison", "register_hessian", "register_biharmonic",
-    "register_regge_curvature", "register_scalars", "register_result", "merge", "screenshot",
+    "register_regge_curvature", "register_scalars", "register_result", "register_creases", "merge", "screenshot",
     "VIEWS", "best_view_direction", "view_rotation", "to_image", "REPR_PNG_SIZE",
 ]
 
@@ -1070,6 +1070,80 @@ def register_scalars(V, F, fields, *, name="mesh", enabled=None, shared_range=Fa
     return _finish(reg, screenshot, size)
 
 
+def register_creases(V: Any, F: Any = None, creases=None, *, feature_angle=40.0, name="creases",
+                     cmap="coolwarm", vminmax=None, radius=0.004, offset=None, view=None,
+                     screenshot=None, size=(1024, 768)) -> Registration:
+    """Register the crease edges of a mesh as a polyscope curve network coloured by θ_e.
+
+    The creases' own curvature is a line measure (:mod:`igl_hhj.features`): the signed
+    dihedral angle θ_e (+ convex, - concave) per crease edge, drawn here in degrees.
+
+    Parameters
+    ----------
+    V : (#V, 3) array_like, F : (#F, 3) array_like int
+    creases : :class:`igl_hhj.features.CreaseNetwork`, optional (e.g.
+        ``feature_principal_curvature(V, F).creases``); default: detected with
+        ``feature_angle``.
+    feature_angle : float, degrees (when ``creases`` is not given).
+    name : str, structure name.
+    cmap : polyscope colour map (diverging by default: convex red, concave blue).
+    vminmax : (lo, hi) in degrees, optional (default symmetric, ± the largest absolute angle).
+    radius : curve radius relative to the scene's length scale.
+    offset, view : as :func:`register_curvature` (use the same to draw the creases
+        on a copy of the surface).
+    screenshot, size : as :func:`register_curvature`.
+
+    Returns
+    -------
+    Registration; ``quantities[(name, "crease angle")]`` holds θ_e in degrees, per edge.
+
+    Examples
+    --------
+    >>> from igl_hhj import viewer
+    >>> from igl_hhj.surfaces.creased import capped_cylinder
+    >>> V, F, _ = capped_cylinder(1)
+    >>> viewer.init("openGL_mock")                                    # doctest: +ELLIPSIS
+    <module 'polyscope' ...>
+    >>> reg = viewer.register_creases(V, F)
+    >>> reg.quantities[("creases", "crease angle")].values.shape    # the 72 rim edges
+    (72,)
+    """
+    from .features import crease_edges, crease_network
+    mesh = as_mesh(V, F)
+    _check_screenshot(screenshot, size)
+    if creases is None:
+        creases = crease_network(mesh, crease_edges(mesh, feature_angle))
+    if len(creases.edges) == 0:
+        raise ValueError("no crease edges to draw (lower feature_angle)")
+    ps = _polyscope_for(screenshot)
+    reg = Registration()
+    X = mesh.V
+    R = _rotation_for(view, mesh.V, mesh.F)
+    if R is not None:
+        X = X @ R.T
+        reg.rotations[name] = R
+    if offset is not None:
+        off = np.asarray(offset, dtype=np.float64)
+        if off.shape != (3,) or not np.all(np.isfinite(off)):
+            raise ValueError(f"offset must be 3 finite numbers, got {offset!r}")
+        X = X + off
+    used = np.unique(creases.edges)                       # only the crease vertices as nodes
+    nodes = X[used]
+    edges = np.searchsorted(used, creases.edges)
+    if ps.has_curve_network(name):
+        ps.remove_curve_network(name)
+    reg.structures[name] = ps.register_curve_network(name, nodes, edges, radius=radius, color=(0.1, 0.1, 0.1))
+    box = np.stack([nodes.min(axis=0), nodes.max(axis=0)])
+    reg.bounds = box
+    _REGISTERED[name] = box
+    deg = np.degrees(creases.theta)
+    rng = _explicit_range(vminmax) if vminmax is not None else color_range(deg, symmetric=True)
+    reg.ranges["crease angle"] = rng
+    _scalar(reg, name, "crease angle", deg, "edges", rng, cmap, enabled=True,
+            label="crease angle θ [degrees]")
+    return _finish(reg, screenshot, size)
+
+
 def merge(*registrations) -> Registration:
     """One :class:`Registration` holding several (e.g. to screenshot them together)."""
     out = Registration()
@@ -1138,16 +1212,15 @@ def _render(reg, path, size, annotate=True):
     ps.set_ground_plane_mode("none")
     projection = ps.get_view_projection_mode()
     # look structures up by name: a Python handle of a removed structure must never be touched
-    missing = [n for n in reg.structures if not ps.has_surface_mesh(n)]
+    missing = [n for n in reg.structures if _structure(ps, n) is None]
     if missing:
         raise ValueError(f"cannot render: structure(s) {missing} are no longer registered in polyscope")
-    others = (ps.get_surface_mesh(n) for n in sorted(set(_REGISTERED) - set(reg.structures))
-              if ps.has_surface_mesh(n))
-    hidden = [s for s in others if s.is_enabled()]
+    others = (_structure(ps, n) for n in sorted(set(_REGISTERED) - set(reg.structures)))
+    hidden = [s for s in others if s is not None and s.is_enabled()]
     for s in hidden:
         s.set_enabled(False)
     for n in reg.structures:
-        ps.get_surface_mesh(n).set_enabled(True)
+        _structure(ps, n).set_enabled(True)
     try:
         camera = None
         if reg.bounds is not None:
@@ -1172,6 +1245,15 @@ def _render(reg, path, size, annotate=True):
         return picture
     reg.screenshot = path
     return path
+
+
+def _structure(ps, name):
+    """The registered surface mesh or curve network called ``name``, or None."""
+    if ps.has_surface_mesh(name):
+        return ps.get_surface_mesh(name)
+    if ps.has_curve_network(name):
+        return ps.get_curve_network(name)
+    return None
 
 
 def _bar_quantities(reg):

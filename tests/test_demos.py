@@ -25,7 +25,8 @@ import pytest
 from conftest import MESH_DIR, png_stats, require_egl
 
 ROOT = Path(__file__).resolve().parents[1]
-DEMOS = ["quickstart", "compare_curvature", "refinement", "boundary_data", "biharmonic", "regge", "curved"]
+DEMOS = ["quickstart", "compare_curvature", "refinement", "boundary_data", "biharmonic", "regge", "curved",
+         "features"]
 SIZE = (320, 200)
 MIN_STD = 0.03        # flat white: 0.0; real demo pictures: >= 0.10
 MIN_DRAWN = 0.10      # fraction of pixels that differ from the background
@@ -232,3 +233,18 @@ def test_quickstart_creates_its_out_dir(tmp_path):
     (tmp_path / "file").write_text("x")
     res = run(["demos/quickstart.py", "--out-dir", str(tmp_path / "file"), "--no-screenshot"], timeout=60)
     assert res.returncode == 2 and "is a file, not a folder" in res.stderr
+
+
+def test_features_demo(tmp_path, requires_egl):
+    import igl
+
+    from igl_hhj.surfaces.creased import capped_cylinder
+    V, F, _ = capped_cylinder(2)
+    path = tmp_path / "capped.off"
+    igl.write_triangle_mesh(str(path), V, F)
+    out = run_demo("features", tmp_path, str(path))
+    header, body = table_rows(out, "Creases above 40 degrees")
+    assert [int(c) for c in body[0][:4]] == [144, 2, 0, 0]          # the two rims
+    header, body = table_rows(out, "saw-tooth")
+    saw = {r[0]: number(r[2]) for r in body}
+    assert saw["HHJ without features (vertex)"] > 4 * saw["HHJ with features (vertex)"], saw

@@ -14,6 +14,7 @@ stop with that command and exit code 2.
 ``biharmonic``         mixed P1 biharmonic solution and its error, convergence rates
 ``regge``              Regge Gauss curvature K_h beside HHJ's and the exact K, Gauss–Bonnet
 ``curved``             HHJ on curved triangles of order m = 1, 2, 3 (Walker's torus / genus 3)
+``features``           fandisk: libigl, HHJ without and with crease handling, the crease network
 =====================  ==========================================================
 """
 from __future__ import annotations
@@ -22,7 +23,7 @@ import importlib
 from typing import Sequence
 
 DEMOS = ("quickstart", "compare_curvature", "refinement", "boundary_data", "biharmonic", "regge",
-         "curved")
+         "curved", "features")
 """Names accepted by :func:`run` and ``igl-hhj demo NAME``."""
 
 

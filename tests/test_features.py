@@ -1,0 +1,324 @@
+"""Sharp features (issue 27): creases as internal boundaries, the crease line measure.
+
+The rate test runs on the exact capped cylinder (:mod:`igl_hhj.surfaces.creased`): with
+features on, the vertex H error in the 2-ring band along the rims converges and
+Σ θ_e|e| → ∫ θ ds; with features off the band error grows (the rim's Dirac measure,
+smeared over a band whose width in rings is fixed)."""
+import warnings
+
+import igl
+import numpy as np
+import pytest
+import scipy.sparse as sp
+from conftest import MESH_DIR
+
+import igl_hhj
+from igl_hhj import features as ft
+from igl_hhj import intrinsic, recovery
+from igl_hhj.convergence import eoc
+from igl_hhj.mesh import as_mesh
+from igl_hhj.surfaces.creased import CappedCylinder, HalfEllipsoid, capped_cylinder, half_ellipsoid
+
+FANDISK = MESH_DIR / "fandisk.off"
+
+
+def ring_distance(mesh, seeds, max_rings):
+    """(#V,) graph distance in rings from the vertices ``seeds`` (max_rings + 1 beyond)."""
+    E, n = mesh.edges, mesh.n_vertices
+    A = sp.coo_matrix((np.ones(2 * len(E)), (np.r_[E[:, 0], E[:, 1]], np.r_[E[:, 1], E[:, 0]])),
+                      shape=(n, n)).tocsr()
+    d = np.full(n, max_rings + 1)
+    reached = np.zeros(n, dtype=bool)
+    reached[seeds] = True
+    d[reached] = 0
+    for k in range(1, max_rings + 1):
+        nxt = reached | (A @ reached > 0)
+        d[nxt & ~reached] = k
+        reached = nxt
+    return d
+
+
+def side_exact_H(surface, cut, face_normals):
+    """Exact H of every cut vertex, from the patch its faces lie on (each side of a crease
+    vertex lies in one patch): the capped cylinder's side / caps, or the half ellipsoid's
+    dome (H of the ellipsoid at the vertex) / flat bottom."""
+    if isinstance(surface, CappedCylinder):
+        flat = np.abs(face_normals[:, 2]) > 0.5
+        return np.where(_on_faces(cut, flat), 0.0, surface.side_mean_curvature())
+    flat = face_normals[:, 2] < -0.5
+    return surface.mean_curvature_at(cut.V, _on_faces(cut, flat))
+
+
+def _on_faces(cut, face_mask):
+    """(#Vc,) bool: cut vertices with an incident face in ``face_mask``."""
+    out = np.zeros(len(cut.V), dtype=bool)
+    out[cut.F[face_mask].ravel()] = True
+    return out
+
+
+SURFACES = {"capped cylinder": (CappedCylinder, capped_cylinder),
+            "half ellipsoid": (HalfEllipsoid, half_ellipsoid)}
+
+
+@pytest.fixture(scope="module", params=list(SURFACES))
+def crease_study(request):
+    make_surface, make_mesh = SURFACES[request.param]
+    s = make_surface()
+    rows = []
+    for level in range(1, 5):
+        V, F, _ = make_mesh(level)
+        mesh = as_mesh(V, F)
+        on = ft.feature_principal_curvature(V, F)
+        _, _, PV1, PV2, _ = igl_hhj.principal_curvature(V, F)
+        Hex = side_exact_H(s, on.cut, mesh.face_normals)
+        band = ring_distance(mesh, np.unique(on.creases.edges), 2) <= 2
+        err_on = np.abs(on.side_mean_curvature - Hex)[band[on.side_parent]].max()
+        err_off = np.abs(0.5 * (PV1 + PV2) - Hex[:len(V)])[band].max()
+        rows.append((mesh.edge_lengths.max(), err_on, err_off, on.creases.total_angle_length,
+                     on.creases.n_chains, len(on.creases.corners), np.abs(Hex).max()))
+    return request.param, s, np.array(rows)
+
+
+def test_band_converges_with_features_and_not_without(crease_study):
+    name, s, rows = crease_study
+    hs, on, off, Hmax = rows[:, 0], rows[:, 1], rows[:, 2], rows[-1, 6]
+    r_on, r_off = eoc(on, hs), eoc(off, hs)
+    assert (r_on >= 0.9).all(), f"{name}, features on, band EOCs {np.round(r_on, 3)} (errors {on})"
+    assert on[-1] < 0.02 * Hmax, f"{name}: finest band error {on[-1]:.3g}"
+    # without features the rim's Dirac measure is smeared into the band: no convergence
+    assert (r_off <= 0).all(), f"{name}, features off, band EOCs {np.round(r_off, 3)} (errors {off})"
+    assert off[-1] > Hmax, f"{name}, features off, finest band error {off[-1]:.3g}"
+
+
+def test_crease_line_measure_converges(crease_study):
+    name, s, rows = crease_study
+    hs, total = rows[:, 0], rows[:, 3]
+    err = np.abs(total - s.crease_integral)
+    r = eoc(err, hs)
+    assert (r >= 0.9).all(), f"{name}: Σθ|e| EOCs {np.round(r, 3)} (errors {err})"
+    assert err[-1] < 0.02 * s.crease_integral
+    rims = 2 if name == "capped cylinder" else 1
+    assert (rows[:, 4] == rims).all() and (rows[:, 5] == 0).all()      # the rims, no corners
+
+
+def test_shape_operator_with_features_is_flat_on_the_caps():
+    V, F, _ = capped_cylinder(2)
+    mesh = as_mesh(V, F)
+    cap = np.abs(mesh.face_normals[:, 2]) > 0.5
+    S_on = igl_hhj.shape_operator(V, F, feature_angle=40)
+    S_off = igl_hhj.shape_operator(V, F)
+    np.testing.assert_array_equal(S_on, ft.feature_shape_operator(V, F, feature_angle=40))
+    assert S_on.shape == (len(F), 3, 3)
+    scale = CappedCylinder().side_mean_curvature()
+    assert np.abs(S_on[cap]).max() < 1e-8 * scale           # planar caps: S_h = 0 exactly
+    assert np.abs(S_off[cap]).max() > scale                 # the rim's jump leaks into the caps
+
+
+def test_default_is_the_libigl_contract_bit_for_bit():
+    """feature_angle=None is today's drop-in; on a smooth mesh (no crease above 40°) the
+    cut is the mesh itself and features on give the same bits."""
+    from igl_hhj.curvature import _shape_operator, dropin_vertex_values
+    from igl_hhj.surfaces import icosphere
+    V, F = icosphere(3)
+    mesh = as_mesh(V, F)
+    ref = dropin_vertex_values(mesh, [_shape_operator(mesh, None, None, None, "auto")], 5)
+    for out in (igl_hhj.principal_curvature(V, F), igl_hhj.principal_curvature(V, F, feature_angle=None),
+                igl_hhj.principal_curvature(V, F, feature_angle=40)):
+        for a, b in zip(out[:4], ref[:4]):
+            np.testing.assert_array_equal(a, b)
+        assert out[4] == ref[4] == []
+    np.testing.assert_array_equal(igl_hhj.shape_operator(V, F, feature_angle=40), igl_hhj.shape_operator(V, F))
+
+
+def _cube():
+    V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]], float)
+    F = np.array([[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4], [1, 2, 6], [1, 6, 5],
+                  [2, 3, 7], [2, 7, 6], [3, 0, 4], [3, 4, 7]])
+    return V, F
+
+
+def test_cube_cut_chains_corners_and_signs():
+    V, F = _cube()
+    mesh = as_mesh(V, F)
+    theta = ft.dihedral_angles(mesh)
+    crease = ft.crease_edges(mesh)
+    assert crease.sum() == 12
+    np.testing.assert_allclose(theta[crease], np.pi / 2)               # convex: +
+    np.testing.assert_allclose(np.abs(theta[~crease]), 0, atol=1e-12)   # face diagonals
+    np.testing.assert_allclose(ft.dihedral_angles(as_mesh(V, F[:, ::-1]))[crease], -np.pi / 2)
+    net = ft.crease_network(mesh, crease)
+    assert net.n_chains == 12 and len(net.corners) == 8 and len(net.endpoints) == 0
+    np.testing.assert_allclose(net.total_angle_length, 12 * np.pi / 2)
+    cut = ft.cut_along(mesh, crease)
+    assert len(cut.V) == 24                                 # 3 sides per corner
+    np.testing.assert_array_equal(cut.parent[:8], np.arange(8))
+    np.testing.assert_array_equal(cut.parent[cut.F], F)     # same faces, same corner order
+    _, cut_mesh = ft._cut_mesh(mesh, crease)              # (no unwelded-seam warning)
+    assert cut_mesh.boundary_edges.sum() == 24              # each cube edge twice
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")                      # the drop-in with features: silent
+        igl_hhj.principal_curvature(V, F, feature_angle=40)
+
+
+def test_detection_matches_igl_sharp_edges():
+    V, F, _ = capped_cylinder(1)
+    V = V + 0.0
+    mesh = as_mesh(V, F)
+    for angle in (20.0, 40.0, 60.0):
+        ours = {tuple(e) for e in mesh.edges[ft.crease_edges(mesh, angle)]}
+        theirs = {tuple(sorted(e)) for e in igl.sharp_edges(V, F, np.radians(angle))}
+        assert ours == theirs
+
+
+def test_slit_end_is_not_split_and_user_edges():
+    from igl_hhj.surfaces import square_grid
+    V2, F = square_grid(6, amount=0.0)
+    V = np.column_stack([V2, np.zeros(len(V2))])
+    mesh = as_mesh(V, F)
+    # a flat mesh: no crease by angle; three user edges along an inner grid line
+    inner = np.flatnonzero(~mesh.boundary_vertices)
+    row = inner[np.isclose(V[inner, 1], V[inner, 1][0])]
+    row = row[np.argsort(V[row, 0])]
+    pairs = np.column_stack([row[:-1], row[1:]])
+    crease = ft.crease_edges(mesh, None, edges=pairs)
+    assert crease.sum() == len(pairs)
+    net = ft.crease_network(mesh, crease)
+    np.testing.assert_array_equal(np.sort(net.endpoints), np.sort(row[[0, -1]]))
+    cut = ft.cut_along(mesh, crease)
+    assert len(cut.V) == len(V) + len(row) - 2              # the two ends keep one side
+    r = ft.feature_principal_curvature(V, F, crease_edges=pairs, feature_angle=None)
+    np.testing.assert_allclose(r.side_PV1, 0, atol=1e-9)    # flat: zero on every side
+    with pytest.raises(ValueError, match="not an edge"):
+        ft.crease_edges(mesh, None, edges=[[row[0], row[2]]])
+    b = mesh.edges[mesh.boundary_edges][0]
+    with pytest.raises(ValueError, match="boundary edge"):
+        ft.crease_edges(mesh, None, edges=[b])
+
+
+@pytest.mark.parametrize("bad,exc", [(True, TypeError), ("40", TypeError), (0, ValueError),
+                                     (180, ValueError), (float("nan"), ValueError)])
+def test_feature_angle_validation(bad, exc):
+    V, F = _cube()
+    with pytest.raises(exc, match="feature_angle"):
+        igl_hhj.principal_curvature(V, F, feature_angle=bad)
+
+
+def test_features_refuse_boundary_data_and_plain():
+    V, F, _ = capped_cylinder(0)
+    with pytest.raises(ValueError, match="boundary_normals"):
+        igl_hhj.principal_curvature(V, F, feature_angle=40, boundary_normals=np.ones((len(V), 3)))
+    with pytest.raises(ValueError, match="boundary='estimate'"):
+        igl_hhj.shape_operator(V, F, feature_angle=40, boundary="plain")
+
+
+def _fandisk():
+    if not FANDISK.is_file():
+        pytest.skip(f"{FANDISK} not available")
+    V, F = igl.read_triangle_mesh(str(FANDISK))
+    return V, F, as_mesh(V, F)
+
+
+def test_fandisk_smooth_parts_stay_smooth():
+    """Planar vertices farther than 2 rings from a crease (exact H = 0): with features on
+    their RMS H is a quarter or less of today's (the crease leaks into them without;
+    what remains is the smoothing's ordinary bias next to the soft 10°-40° edges where
+    a plane meets a curved blend); curved vertices beyond the smoothing's reach change
+    by at most 5 %."""
+    V, F, mesh = _fandisk()
+    on = ft.feature_principal_curvature(V, F)
+    _, _, PV1, PV2, _ = igl_hhj.principal_curvature(V, F)
+    H0, H1 = 0.5 * (PV1 + PV2), 0.5 * (on.PV1 + on.PV2)
+    d = ring_distance(mesh, np.unique(on.creases.edges), 40)
+    fn, N = mesh.face_normals, mesh.vertex_normals
+    spread = np.zeros(mesh.n_vertices)                      # 1 - min ν_T·N over the star
+    np.maximum.at(spread, F.ravel(), 1 - np.einsum("ma,ma->m", np.repeat(fn, 3, axis=0), N[F.ravel()]))
+    planar = (spread < 1e-12) & (d > 2)
+    scale = np.median(np.abs(H0))
+    assert planar.sum() > 100
+    rms_on, rms_off = np.sqrt(np.mean(H1[planar] ** 2)), np.sqrt(np.mean(H0[planar] ** 2))
+    assert 4 * rms_on <= rms_off, f"planar RMS H: features on {rms_on:.3g}, off {rms_off:.3g}"
+    # reach of the smoothing in rings: 2.5 times its largest length
+    # (SMOOTHING_PER_RADIUS · radius · the adaptive factor's upper bound)
+    reach = int(np.ceil(2.5 * recovery.SMOOTHING_PER_RADIUS * 5 * intrinsic.ADAPTIVE_RANGE[1]))
+    curved = np.abs(H0) > scale
+    rel = np.abs(H1 - H0) / np.where(curved, np.abs(H0), np.inf)
+    profile = [rel[d >= k].max() for k in (3, 5, 8, reach)]   # the change is the leak: it decays
+    assert np.all(np.diff(profile) < 0), f"max relative change at 3, 5, 8, {reach} rings: {profile}"
+    assert (curved & (d >= reach)).sum() >= 5
+    assert profile[-1] <= 0.05, f"max relative change {profile[-1]:.3f} beyond {reach} rings"
+
+
+def test_fandisk_face_saw_tooth_is_gone():
+    """The per-face S_h jumps between neighbouring faces near a crease (red/blue
+    saw-tooth) as much as anywhere else with features on, and far more without."""
+    V, F, mesh = _fandisk()
+    crease = ft.crease_edges(mesh)
+    near = np.zeros(mesh.n_vertices, dtype=bool)
+    near[mesh.edges[crease].ravel()] = True
+    strip = near[F].any(axis=1)                             # faces touching a crease
+    inner = np.flatnonzero((mesh.edge_face_count == 2) & ~crease)
+    f0, f1 = mesh.edge_faces[inner, 0], mesh.edge_faces[inner, 1]
+    in_strip, away = strip[f0] & strip[f1], ~strip[f0] & ~strip[f1]
+
+    def jumps(S):
+        H = 0.5 * np.trace(S, axis1=1, axis2=2)
+        d = H[f0] - H[f1]
+        return np.sqrt(np.mean(d[in_strip] ** 2)), np.sqrt(np.mean(d[away] ** 2))
+
+    s_on, a_on = jumps(igl_hhj.shape_operator(V, F, feature_angle=40))
+    s_off, a_off = jumps(igl_hhj.shape_operator(V, F))
+    assert s_on <= 1.25 * a_on, f"features on: strip {s_on:.3f}, away {a_on:.3f}"
+    assert s_off >= 4 * a_off, f"features off: strip {s_off:.3f}, away {a_off:.3f}"
+
+
+def test_cli_and_batch_feature_angle(tmp_path, capsys):
+    from igl_hhj import batch, cli
+    V, F, _ = capped_cylinder(1)
+    path = tmp_path / "capped.off"
+    igl.write_triangle_mesh(str(path), V, F)
+    V, F = igl.read_triangle_mesh(str(path))                # what the CLI reads
+    ref = igl_hhj.principal_curvature(V, F, feature_angle=40)
+    out = tmp_path / "c.npz"
+    assert cli.main(["curvature", str(path), "--feature-angle", "40", "-o", str(out)]) == 0
+    said = capsys.readouterr().out
+    assert "creases (--feature-angle 40): 72 edges in 2 chains, 0 corners" in said
+    with np.load(out) as z:
+        np.testing.assert_array_equal(z["k1"], ref[2])
+        np.testing.assert_array_equal(z["S"], igl_hhj.shape_operator(V, F, feature_angle=40))
+    res = batch.run_batch([path], tmp_path / "b", workers=0, progress=False, feature_angle=40)
+    assert res.counts()["ok"] == 1
+    with np.load(tmp_path / "b" / "capped.npz") as z:
+        np.testing.assert_array_equal(z["k1"], ref[2])
+    assert batch.options_key("hhj", "vertex", None) == {"method": "hhj", "per": "vertex", "radius": 5}
+    for argv in (["--feature-angle", "200"], ["--feature-angle", "40", "--method", "igl"],
+                 ["--feature-angle", "40", "--per", "face", "--radius", "2"]):
+        assert cli.main(["curvature", str(path)] + argv) == 2
+        assert "feature-angle" in capsys.readouterr().err
+
+
+def test_cli_screenshot_draws_the_creases(tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    from conftest import png_stats, require_egl
+    require_egl()
+    V, F, _ = capped_cylinder(1)
+    path = tmp_path / "capped.off"
+    igl.write_triangle_mesh(str(path), V, F)
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    env = dict(os.environ, PYTHONPATH=root + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    pngs = {}
+    for tag, extra in (("off", []), ("on", ["--feature-angle", "40"])):
+        pngs[tag] = tmp_path / f"{tag}.png"
+        res = subprocess.run([sys.executable, "-m", "igl_hhj.cli", "curvature", str(path), "-q",
+                              "--screenshot", str(pngs[tag]), "--size", "400", "300", *extra],
+                             env=env, capture_output=True, text=True, timeout=120)
+        assert res.returncode == 0, res.stderr
+    import matplotlib.image as mpimg
+    assert (png_stats(pngs["on"])["width"], png_stats(pngs["on"])["height"]) == (400, 300)
+    bars = {}
+    for tag, p in pngs.items():                             # the colour-bar strip at the bottom
+        im = mpimg.imread(str(p))[..., :3]
+        bars[tag] = float((im[-40:].min(axis=2) < 0.9).mean())
+    assert bars["on"] > 1.3 * bars["off"], bars             # a second bar: crease angle θ
