@@ -8,70 +8,20 @@ import numpy as np
 import pytest
 
 from conftest import sequence
+from igl_hhj.benchmarks import walker_hessian as wh
 from igl_hhj.convergence import eoc
 from igl_hhj.curved import CurvedHHJ, LagrangeSurface, modified_interpolant, shape_operator, surface_hessian
 from igl_hhj.curved.hessian import conormal_load
-from igl_hhj.curved.reference import lagrange_nodes
 
 
-def _w(X):
-    """w = exp(x) sin(y) (ambient, restricted to Γ)."""
-    return np.exp(X[:, 0]) * np.sin(X[:, 1])
-
-
-def _grad_w(X):
-    ex = np.exp(X[:, 0])
-    return np.stack([ex * np.sin(X[:, 1]), ex * np.cos(X[:, 1]), 0 * ex], axis=1)
-
-
-def _exact_hessian(surface, X):
-    """∇_Γ∇_Γ w = P ∇²w P − (ν·∇w) ∇_Γν at points X on Γ (the closed form that
-    tests/test_curvature.py checks by finite differences along surface curves)."""
-    ex, s, c = np.exp(X[:, 0]), np.sin(X[:, 1]), np.cos(X[:, 1])
-    H = np.zeros((len(X), 3, 3))
-    H[:, 0, 0], H[:, 0, 1], H[:, 1, 0], H[:, 1, 1] = ex * s, ex * c, ex * c, -ex * s
-    nu = surface.normal(X)
-    P = np.eye(3) - nu[:, :, None] * nu[:, None, :]
-    return P @ H @ P - np.einsum("ij,ij->i", _grad_w(X), nu)[:, None, None] * surface.shape_operator(X)
-
-
-def _node_images(V, F, surf, project):
-    """Ψ^m of every node: the exact map F_T at the node's reference position on the flat
-    triangle (Walker's modified interpolant moves the nodes themselves off Γ)."""
-    xi = lagrange_nodes(surf.order)
-    bary = np.column_stack([1 - xi.sum(1), xi])                       # (nb, 3)
-    flat = np.einsum("bc,fck->fbk", bary, np.asarray(V)[np.asarray(F)])
-    out = np.empty((surf.n_nodes, 3))
-    out[surf.elements.ravel()] = project(flat.reshape(-1, 3))
-    return out
-
-
-def _l2_error(field, surf, s):
-    faces, bary, wq = surf.quadrature(2 * surf.order + 4)
-    X = s.project(surf.points(faces, bary))
-    d = _exact_hessian(s, X) - field(faces, bary)
-    return float(np.sqrt(np.sum(wq * (d ** 2).sum(axis=(1, 2)))))
+_w, _grad_w, _node_images = wh.w, wh.grad_w, wh.node_images
 
 
 @functools.cache
 def _rates(name, order, degree, levels, boundary="none", data="walker"):
-    s, seq = sequence(name, levels)
-    errs, hs = [], []
-    for V, F in seq:
-        surf = LagrangeSurface.from_projection(V, F, order, s.project)
-        w = (modified_interpolant(V, F, order, _w, project=s.project) if data == "walker"
-             else _w(_node_images(V, F, surf, s.project)))
-        kw = {}
-        if boundary == "clamped":
-            Y = _node_images(V, F, surf, s.project)
-            nu = s.normal(Y)
-            g = _grad_w(Y)
-            kw["boundary_gradient"] = g - np.einsum("ij,ij->i", g, nu)[:, None] * nu     # ∇_Γ w = P ∇w
-        elif boundary == "zero":
-            kw["boundary_gradient"] = np.zeros((surf.n_nodes, 3))
-        errs.append(_l2_error(surface_hessian(surf, w, degree=degree, **kw), surf, s))
-        hs.append(surf.h)
-    return np.array(errs), eoc(errs, hs)
+    """(errors, EOCs) of walker_hessian.errors on the test sequences (tests/conftest.py's)."""
+    errs, hs = wh.errors(name, order, degree, levels, boundary, data)
+    return errs, eoc(errs, hs)
 
 
 @pytest.mark.parametrize("name,order,degree", [
@@ -189,3 +139,31 @@ def test_modified_interpolant_of_the_coordinates_is_the_node_placement():
         modified_interpolant(V, F, 2, _w)
     with pytest.raises(TypeError, match="callable"):
         modified_interpolant(V, F, 2, np.zeros(3), project=s.project)
+
+
+def test_benchmark_sequences_are_the_test_sequences():
+    for name in ("torus", "ellipsoid", "saddle"):
+        _, a = sequence(name, 2)
+        _, b = wh.sequence(name, 2)
+        for (Va, Fa), (Vb, Fb) in zip(a, b):
+            np.testing.assert_array_equal(Fa, Fb)
+            np.testing.assert_allclose(Va, Vb, atol=0)
+
+
+def test_exact_hessian_by_finite_differences_on_the_torus():
+    """dᵀ(∇_Γ∇_Γ w)d = d²/dt² w(γ(t)) − ∇_Γ w·γ''(0) for γ(t) = π(x + t d), d tangent."""
+    from igl_hhj.surfaces import WalkerTorus
+    s = WalkerTorus()
+    rng = np.random.default_rng(3)
+    X = s.project(rng.normal(size=(20, 3)))
+    nu = s.normal(X)
+    d = rng.normal(size=(20, 3))
+    d -= np.einsum("ij,ij->i", d, nu)[:, None] * nu
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    eps = 1e-4
+    g0, gp, gm = X, s.project(X + eps * d), s.project(X - eps * d)
+    second = (_w(gp) - 2 * _w(g0) + _w(gm)) / eps ** 2
+    acc = (gp - 2 * g0 + gm) / eps ** 2
+    P = np.eye(3) - nu[:, :, None] * nu[:, None, :]
+    rhs = second - np.einsum("na,na->n", np.einsum("nab,nb->na", P, _grad_w(X)), np.einsum("nab,nb->na", P, acc))
+    np.testing.assert_allclose(np.einsum("na,nab,nb->n", d, wh.exact_hessian(s, X), d), rhs, atol=2e-5)

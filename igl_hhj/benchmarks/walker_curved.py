@@ -250,6 +250,24 @@ def _fmt_eoc(x):
     return "" if x is None or not np.isfinite(x) else f" ({x:.2f})"
 
 
+def paper_comparison(ks, rows, rates, paper):
+    """One line: ours / paper per column at the last level that the paper has, and the
+    EOC differences (ours − paper) there."""
+    last = [i for i, k in enumerate(ks) if k < len(paper)]
+    if not last:
+        return "(no paper row at these levels)"
+    i = last[-1]
+    k = ks[i]
+    pe, pr = paper[k]
+    ratio = ", ".join(f"{h} {rows[i][key] / v:.2f}" for h, key, v in zip(HEAD, KEYS, pe))
+    diffs = [f"{h} {rates[key][i] - q:+.2f}" for h, key, q in zip(HEAD, KEYS, pr)
+             if q is not None and np.isfinite(rates[key][i])]
+    text = f"At k = {k}, ours / paper: {ratio}."
+    if diffs:
+        text += " EOC ours − paper: " + ", ".join(diffs) + "."
+    return text
+
+
 def format_curved_table(name, m, rows, m1_cond=None, heading="##"):
     """Markdown table: our rows k beside the paper's rows (Walker Tables 2–5, block m).
 
@@ -271,6 +289,7 @@ def format_curved_table(name, m, rows, m1_cond=None, heading="##"):
             pe, pr = paper[k]
             lines.append(f"| paper {k} | | | " + " | ".join(f"{_fmt(v)}{_fmt_eoc(q)}" for v, q in zip(pe, pr)) + " | |")
     lines.append("")
+    lines += paper_comparison(ks, rows, rates, paper), ""
     if any(np.isfinite(r["cond_A"]) for r in rows):
         lines += ["| k | #DOF | κ(A^m) | κ(D⁻¹A^m) | κ(S^m) condensed | κ(D⁻¹S^m) |"
                   + (" κ(A^m)/κ(A^1) |" if m1_cond else ""),

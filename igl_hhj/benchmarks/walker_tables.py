@@ -286,6 +286,9 @@ def format_table(name, rows, heading="##"):
             pcells = [f"{_fmt(v)}{_fmt_eoc(q)}" for v, q in zip(pe, pr)]
             lines.append(f"| paper {k} | {paper['faces0'] * 4 ** k} | | " + " | ".join(pcells) + " | | |")
     lines.append("")
+    if not name.endswith("_plain"):
+        from .walker_curved import paper_comparison
+        lines += paper_comparison(ks, rows, rates, paper["rows"]), ""
     if any(np.isfinite(r["cond_A"]) for r in rows):
         lines += [f"Condition numbers (Walker Table 1, {base}): ours κ(A) (κ(D⁻¹A), D = diag A) | paper (D = lumped A)",
                   "", "| k | ours κ(A) | ours κ(D⁻¹A) | paper κ(A) | paper κ(D⁻¹A) |", "|---|---|---|---|---|"]
