@@ -81,8 +81,9 @@ def test_walker_table_rates_and_paper_errors(name):
         n_paper = paper["faces0"] * 4 ** k
         assert abs(r["faces"] - n_paper) <= 0.05 * n_paper, (name, k, r["faces"], n_paper)
         for j, key in enumerate(("nu", "S", "S_inf_centroid", "kappa_a", "kappa_g")):
-            # L∞: the paper's column is matched by the max |entry| at face centroids; the
-            # project's S_inf (Frobenius at the corners) is 3-7x larger (reported, not asserted)
+            # L∞: the paper does not define its sampling; the max |entry| at face centroids
+            # stays within 3x of its column (1.0-2.4x at k = 4), the project's S_inf
+            # (Frobenius at the corners) is 3.7-7.3x (reported, not asserted)
             ratio = r[key] / paper["rows"][k][0][j]
             assert 1 / 3 <= ratio <= 3, f"{name} k={k} {key}: ours/paper = {ratio:.2f}"
     # the ν error is O(h) with constant ≈ the paper's
