@@ -375,3 +375,22 @@ def test_walker_tables_orders_cli(tmp_path, capsys):
     assert eoc_S > 1.8
     assert set(PAPER_CURVED) == {"saddle", "dumbbell", "torus", "genus3"}
     assert all(len(PAPER_CURVED[n][m]) >= 4 for n in PAPER_CURVED for m in (2, 3))
+
+
+def test_walker_tables_append_min_level(tmp_path):
+    """--min-level skips the coarse solves (rows carry their k; no EOC without the level
+    before); --append adds a section with the command line and the ours/paper line."""
+    from igl_hhj.benchmarks.walker_tables import main
+    (tmp_path / "walker_tables_curved.md").write_text("# existing\n", encoding="utf-8")
+    main(["--orders", "2", "--surfaces", "saddle", "--curved-levels", "3", "--min-level", "1",
+          "--append", "--out", str(tmp_path)])
+    text = (tmp_path / "walker_tables_curved.md").read_text(encoding="utf-8")
+    assert text.startswith("# existing\n") and "## Further rows: `python -m igl_hhj.benchmarks.walker_tables" in text
+    assert "### saddle, m = 2" in text and "peak memory" in text
+    assert not any(r.startswith("| 0 | 448 |") for r in text.splitlines())
+    row1 = next(r for r in text.splitlines() if r.startswith("| 1 | 1792"))
+    row2 = next(r for r in text.splitlines() if r.startswith("| 2 | 7168"))
+    assert "(" not in row1.split("|")[5] and float(row2.split("|")[5].split("(")[1].rstrip(") ")) > 1.8
+    line = next(r for r in text.splitlines() if r.startswith("At k = 2, ours / paper:"))
+    ratio = float(line.split("‖S‖L2 ")[1].split(",")[0])
+    assert 0.3 < ratio < 3, line

@@ -6,7 +6,7 @@ import importlib
 import pytest
 
 MODULES = ["igl_hhj.curvature", "igl_hhj.convergence", "igl_hhj.viewer", "igl_hhj.interop", "igl_hhj.mesh_io",
-           "igl_hhj.demos", "igl_hhj.repair", "igl_hhj.features"]
+           "igl_hhj.demos", "igl_hhj.repair", "igl_hhj.features", "igl_hhj.curved.hessian"]
 
 
 @pytest.mark.parametrize("name", MODULES)

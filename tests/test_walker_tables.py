@@ -81,8 +81,9 @@ def test_walker_table_rates_and_paper_errors(name):
         n_paper = paper["faces0"] * 4 ** k
         assert abs(r["faces"] - n_paper) <= 0.05 * n_paper, (name, k, r["faces"], n_paper)
         for j, key in enumerate(("nu", "S", "S_inf_centroid", "kappa_a", "kappa_g")):
-            # L∞: the paper's column is matched by the max |entry| at face centroids; the
-            # project's S_inf (Frobenius at the corners) is 3-7x larger (reported, not asserted)
+            # L∞: the paper does not define its sampling; the max |entry| at face centroids
+            # stays within 3x of its column (1.0-2.4x at k = 4), the project's S_inf
+            # (Frobenius at the corners) is 3.7-7.3x (reported, not asserted)
             ratio = r[key] / paper["rows"][k][0][j]
             assert 1 / 3 <= ratio <= 3, f"{name} k={k} {key}: ours/paper = {ratio:.2f}"
     # the ν error is O(h) with constant ≈ the paper's
@@ -293,3 +294,24 @@ def test_benchmark_run_tiny(tmp_path):
         surface_levels("cube", 1)
     with pytest.raises(ValueError, match="SPD"):
         condition_numbers(-A)
+
+
+def test_walker_figure_data():
+    """Figs. 3-6 data (walker_figures): κ_h^g = k1 k2 (eq. 6.1), d1 the minimum and d2 the maximum
+    curvature direction (the captions' red / black), unit, orthogonal, tangent; κ_h^g close to
+    the exact one on the saddle at k = 1 (relative rms error measured 0.089; 0.20 at k = 0)."""
+    import igl
+
+    from igl_hhj.benchmarks.walker_figures import FIGURES, figure_data
+    d = figure_data("saddle", level=1)
+    N = igl.per_face_normals(d["V"], d["F"], np.array([0.0, 0.0, 1.0]))
+    np.testing.assert_allclose(d["kg"], d["k1"] * d["k2"], rtol=1e-8, atol=1e-8)
+    assert (d["k1"] <= d["k2"] + 1e-12).all()
+    for v in (d["d1"], d["d2"]):
+        np.testing.assert_allclose(np.linalg.norm(v, axis=1), 1.0, atol=1e-12)
+        assert np.abs(np.einsum("ij,ij->i", v, N)).max() < 1e-10
+    assert np.abs(np.einsum("ij,ij->i", d["d1"], d["d2"])).max() < 1e-10
+    assert len(d["F"]) == 1792
+    rel = np.sqrt(np.mean((d["kg"] - d["kg_exact"]) ** 2)) / np.sqrt(np.mean(d["kg_exact"] ** 2))
+    assert rel < 0.15, rel
+    assert [FIGURES[n][0] for n in ("saddle", "dumbbell", "torus", "genus3")] == [3, 4, 5, 6]

@@ -183,17 +183,20 @@ def curved_levels(name, n_levels, seed=0):
 
 
 def run_curved(surfaces, orders=(2, 3), levels=3, cond_levels=2, progress=True, seed=0,
-               max_faces=None, interpolant="walker"):
+               max_faces=None, interpolant="walker", min_level=0):
     """Errors of the curved HHJ shape operator per surface and order.
 
+    ``min_level``: levels k < min_level are refined through but not solved (to add the
+    finest rows of a table without recomputing the coarse ones).
+
     Returns dict (name, m) → list of per-level dicts (keys of
-    :func:`igl_hhj.curved.errors.shape_operator_errors` plus ``seconds``,
+    :func:`igl_hhj.curved.errors.shape_operator_errors` plus ``k``, ``seconds``,
     ``cond_A``, ``cond_DA`` (NaN beyond ``cond_levels``), ``dofs``)."""
     from .walker_tables import condition_numbers
     bar = None
     if progress:
         from tqdm.auto import tqdm
-        bar = tqdm(total=len(surfaces) * len(orders) * levels, desc="walker curved", unit="level")
+        bar = tqdm(total=len(surfaces) * len(orders) * (levels - min_level), desc="walker curved", unit="level")
     res = {}
     for name in surfaces:
         surface, seq = curved_levels(name, levels, seed)
@@ -202,6 +205,8 @@ def run_curved(surfaces, orders=(2, 3), levels=3, cond_levels=2, progress=True, 
             for k, (V, F, emap) in enumerate(seq):
                 if max_faces is not None and len(F) > max_faces:
                     break
+                if k < min_level:
+                    continue
                 t0 = time.perf_counter()
                 surf = LagrangeSurface.from_parametrization(V, F, m, emap, interpolant=interpolant)
                 kw = {}
@@ -212,6 +217,7 @@ def run_curved(surfaces, orders=(2, 3), levels=3, cond_levels=2, progress=True, 
                 fld = shape_operator(surf, **kw)
                 e = shape_operator_errors(fld, surface)
                 e["seconds"] = time.perf_counter() - t0
+                e["k"] = k
                 e["dofs"] = fld.space.n_dofs
                 e["cond_A"] = e["cond_DA"] = e["cond_S"] = e["cond_DS"] = float("nan")
                 if cond_levels is not None and k < cond_levels:
@@ -244,21 +250,46 @@ def _fmt_eoc(x):
     return "" if x is None or not np.isfinite(x) else f" ({x:.2f})"
 
 
-def format_curved_table(name, m, rows, m1_cond=None):
-    """Markdown table: our rows k beside the paper's rows (Walker Tables 2–5, block m)."""
+def paper_comparison(ks, rows, rates, paper):
+    """One line: ours / paper per column at the last level that the paper has, and the
+    EOC differences (ours − paper) there."""
+    last = [i for i, k in enumerate(ks) if k < len(paper)]
+    if not last:
+        return "(no paper row at these levels)"
+    i = last[-1]
+    k = ks[i]
+    pe, pr = paper[k]
+    ratio = ", ".join(f"{h} {rows[i][key] / v:.2f}" for h, key, v in zip(HEAD, KEYS, pe))
+    diffs = [f"{h} {rates[key][i] - q:+.2f}" for h, key, q in zip(HEAD, KEYS, pr)
+             if q is not None and np.isfinite(rates[key][i])]
+    text = f"At k = {k}, ours / paper: {ratio}."
+    if diffs:
+        text += " EOC ours − paper: " + ", ".join(diffs) + "."
+    return text
+
+
+def format_curved_table(name, m, rows, m1_cond=None, heading="##"):
+    """Markdown table: our rows k beside the paper's rows (Walker Tables 2–5, block m).
+
+    Rows carry their level ``k`` (default: their index); the EOC is printed between
+    consecutive levels only."""
     paper = PAPER_CURVED[name][m]
     hs = [r["h"] for r in rows]
+    ks = [r.get("k", i) for i, r in enumerate(rows)]
     rates = {key: np.concatenate([[np.nan], eoc([r[key] for r in rows], hs)]) if len(rows) > 1
              else np.array([np.nan]) for key in KEYS}
-    lines = [f"## {name}, m = {m} (HHJ r = {m - 1}) — boundary: {BOUNDARY[name]}", "",
+    for key in KEYS:
+        rates[key][1:][np.diff(ks) != 1] = np.nan
+    lines = [f"{heading} {name}, m = {m} (HHJ r = {m - 1}) — boundary: {BOUNDARY[name]}", "",
              "| k | #F | h | " + " | ".join(HEAD) + " | s |", "|---|---|---|" + "---|" * (len(HEAD) + 1)]
-    for k, r in enumerate(rows):
-        cells = [f"{_fmt(r[key])}{_fmt_eoc(rates[key][k])}" for key in KEYS]
+    for i, (k, r) in enumerate(zip(ks, rows)):
+        cells = [f"{_fmt(r[key])}{_fmt_eoc(rates[key][i])}" for key in KEYS]
         lines.append(f"| {k} | {r['faces']} | {r['h']:.3g} | " + " | ".join(cells) + f" | {r['seconds']:.1f} |")
         if k < len(paper):
             pe, pr = paper[k]
             lines.append(f"| paper {k} | | | " + " | ".join(f"{_fmt(v)}{_fmt_eoc(q)}" for v, q in zip(pe, pr)) + " | |")
     lines.append("")
+    lines += paper_comparison(ks, rows, rates, paper), ""
     if any(np.isfinite(r["cond_A"]) for r in rows):
         lines += ["| k | #DOF | κ(A^m) | κ(D⁻¹A^m) | κ(S^m) condensed | κ(D⁻¹S^m) |"
                   + (" κ(A^m)/κ(A^1) |" if m1_cond else ""),
