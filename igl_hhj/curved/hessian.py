@@ -18,8 +18,8 @@ from __future__ import annotations
 import numpy as np
 
 from .hhj import CurvedHHJ
-from .reference import CORNERS, EDGE_OUTWARD, EDGE_TANGENTS, lagrange_basis, line_quadrature
-from .surface import ElementGeometry, LagrangeSurface
+from .reference import lagrange_basis
+from .surface import LagrangeSurface
 
 __all__ = ["surface_hessian", "HessianField"]
 
@@ -81,37 +81,15 @@ def conormal_load(space, edges, w=None, gradient=None):
     """
     surf = space.surface
     k = (w if gradient is None else gradient).shape[-1]
-    out = np.zeros((space.n_dofs, k))
-    edges = np.asarray(edges, dtype=np.int64)
-    if edges.size == 0:
-        return out
-    f, jloc = surf.boundary_face_and_local(edges)
-    tg, wg = line_quadrature(space.r + space.m + 3)
     Bm = lagrange_basis(space.m)
-    for j in range(3):                                               # 3 local edges: vectorised over faces
-        sel = jloc == j
-        if not sel.any():
-            continue
-        fj = f[sel]
-        A0, B0 = CORNERS[(j + 1) % 3], CORNERS[(j + 2) % 3]
-        exi = A0[None] + tg[:, None] * (B0 - A0)[None]
-        X = surf.nodes[surf.elements[fj]]
-        ge = ElementGeometry(X, exi, space.m)
-        speed = np.linalg.norm(np.einsum("fgkd,d->fgk", ge.J, EDGE_TANGENTS[j]), axis=2)
-        a = np.einsum("fgde,e->fgd", ge.Ginv, EDGE_OUTWARD[j])
-        n = np.einsum("fgkd,fgd->fgk", ge.J, a)
-        n /= np.linalg.norm(n, axis=2, keepdims=True)                 # unit outward conormal n̂
+
+    def n_dot_xi(j, fj, exi, ge, n):
         if gradient is None:
             grad = np.einsum("fgkd,fgde,gae,fac->fgkc", ge.J, ge.Ginv, ge.dN, w[surf.elements[fj]])
         else:
             grad = np.einsum("ga,fakc->fgkc", Bm.values(exi), gradient[surf.elements[fj]])
-        nxi = np.einsum("fgk,fgkc->fgc", n, grad)                     # n̂ · ξ   (f, g, k)
-        Se = space.reference_basis(exi)
-        nnf = np.einsum("d,gbde,e->gb", EDGE_OUTWARD[j], Se, EDGE_OUTWARD[j])
-        # φ^nn ds = p_j / |J t̂_j|² · |J t̂_j| dt
-        loc = np.einsum("g,fg,gb,fgc->fbc", wg, 1.0 / speed, nnf, nxi) * space.scale[fj][:, :, None]
-        np.add.at(out, space.dofs[fj].ravel(), loc.reshape(-1, k))
-    return out
+        return np.einsum("fgk,fgkc->fgc", n, grad)                    # n̂ · ξ   (f, g, k)
+    return space.boundary_edge_load(edges, k, n_dot_xi)
 
 
 def surface_hessian(surface, w, *, boundary_gradient=None, degree=None, solver="auto", condense=True):

@@ -322,15 +322,32 @@ class CurvedHHJ:
         (interpolated by the degree-m Lagrange basis along the edge, Walker's
         I_h^m ν).  Without data (None) the ν̃ term is dropped: the load then
         cancels B's one-sided boundary term (the plain assembly)."""
+        Bm = lagrange_basis(self.m)
+
+        def xi_term(j, fj, exi, ge, n):
+            if normal_data is None:
+                return n
+            nt = np.einsum("ga,fak->fgk", Bm.values(exi), normal_data[self.surface.elements[fj]])
+            nt /= np.linalg.norm(nt, axis=2, keepdims=True)
+            return n - np.einsum("fgk,fgk->fg", n, nt)[..., None] * nt
+        return self.boundary_edge_load(edges, 3, xi_term)
+
+    def boundary_edge_load(self, edges, k, integrand):
+        """``∫_E φ^nn g ds`` over the boundary edges ``edges`` (#e,) of the (#e,) faces
+        holding them, for a k-vector field g given by ``integrand(j, faces, points, geometry,
+        n)`` → (f, g, k) at the edge quadrature points (exact for degree r + m + 3 in the
+        edge parameter; ``points`` (g, 3) reference barycentrics on local edge j, ``geometry``
+        the :class:`ElementGeometry` there, ``n`` (f, g, 3) the unit outward conormal n̂).
+        Returns (n_dofs, k); shared by :meth:`boundary_edge_terms` and
+        :func:`igl_hhj.curved.hessian.conormal_load`."""
         surf = self.surface
-        out = np.zeros((self.n_dofs, 3))
+        out = np.zeros((self.n_dofs, k))
         edges = np.asarray(edges, dtype=np.int64)
         if edges.size == 0:
             return out
         f, jloc = surf.boundary_face_and_local(edges)
         tg, wg = line_quadrature(self.r + self.m + 3)
-        Bm = lagrange_basis(self.m)
-        for j in range(3):                                           # 3 local edges
+        for j in range(3):                                           # 3 local edges: vectorised over faces
             sel = jloc == j
             if not sel.any():
                 continue
@@ -339,21 +356,16 @@ class CurvedHHJ:
             exi = A0[None] + tg[:, None] * (B0 - A0)[None]
             X = surf.nodes[surf.elements[fj]]
             ge = ElementGeometry(X, exi, self.m)
-            sp_ = np.einsum("fgkd,d->fgk", ge.J, EDGE_TANGENTS[j])
-            speed = np.linalg.norm(sp_, axis=2)
+            speed = np.linalg.norm(np.einsum("fgkd,d->fgk", ge.J, EDGE_TANGENTS[j]), axis=2)
             a = np.einsum("fgde,e->fgd", ge.Ginv, EDGE_OUTWARD[j])
             n = np.einsum("fgkd,fgd->fgk", ge.J, a)
-            n /= np.linalg.norm(n, axis=2, keepdims=True)
-            xi_term = n.copy()
-            if normal_data is not None:
-                Nv = Bm.values(exi)
-                nt = np.einsum("ga,fak->fgk", Nv, normal_data[surf.elements[fj]])
-                nt /= np.linalg.norm(nt, axis=2, keepdims=True)
-                xi_term -= np.einsum("fgk,fgk->fg", n, nt)[..., None] * nt
+            n /= np.linalg.norm(n, axis=2, keepdims=True)                 # unit outward conormal n̂
+            g = integrand(j, fj, exi, ge, n)
             Se = self.reference_basis(exi)
             nnf = np.einsum("d,gbde,e->gb", EDGE_OUTWARD[j], Se, EDGE_OUTWARD[j])
-            loc = np.einsum("g,fg,gb,fgk->fbk", wg, 1.0 / speed, nnf, xi_term) * self.scale[fj][:, :, None]
-            np.add.at(out, self.dofs[fj].ravel(), loc.reshape(-1, 3))
+            # φ^nn ds = p_j / |J t̂_j|² · |J t̂_j| dt
+            loc = np.einsum("g,fg,gb,fgk->fbk", wg, 1.0 / speed, nnf, g) * self.scale[fj][:, :, None]
+            np.add.at(out, self.dofs[fj].ravel(), loc.reshape(-1, k))
         return out
 
     def edge_dof_points(self, edges):
