@@ -29,21 +29,9 @@ def sequence(name, levels):
     """Cached non-uniform mesh sequences shared by several test modules
     (building them is the expensive part of the rate tests)."""
     from igl_hhj import surfaces as su
-    if name == "ellipsoid":
-        s = su.Ellipsoid()
-        return s, su.mesh_sequence(*su.ellipsoid_coarse(s, subdivisions=2, amount=0.2), s, levels)
-    if name == "torus":
-        s = su.WalkerTorus()
-        return s, su.mesh_sequence(*su.torus_coarse(n_phi=16, n_t=8, amount=0.2), s, levels)
-    if name == "saddle":
-        s = su.WalkerSaddle()
-        return s, su.mesh_sequence(*su.graph_coarse(s, n=6, amount=0.2), s, levels)
-    if name == "sphere":
-        s = su.Sphere()
-        V, F = su.icosphere(1)
-        V = su.jitter_tangentially(V, F, s, 0.3, seed=1)
-        return s, su.mesh_sequence(V, F, s, levels)
-    raise KeyError(name)
+    if name not in su.STANDARD_SEQUENCES:
+        raise KeyError(name)
+    return su.standard_sequence(name, levels)
 
 
 # --------------------------------------------------------------------------- defect meshes (issue 24)

@@ -112,6 +112,20 @@ inline double min_rotation(const double* x, const double* a, const double* b, do
     return c;
 }
 
+// Per-vertex frames fr (nV, 9): the normal (N, or +z where a component of N is not
+// finite) and its tangent_frame (e1, e2): intrinsic.vertex_frames.
+inline void normal_frames(const double* N, i64 nV, double* fr, int nt) {
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+    for (i64 v = 0; v < nV; ++v) {
+        double* n = fr + 9 * v;
+        const bool fin = std::isfinite(N[3 * v]) && std::isfinite(N[3 * v + 1]) && std::isfinite(N[3 * v + 2]);
+        for (int a = 0; a < 3; ++a) n[a] = fin ? N[3 * v + a] : (a == 2 ? 1.0 : 0.0);
+        tangent_frame(n, n + 3, n + 6);
+    }
+}
+
 // out = P S P, P = I - n n^T (projection of a 3x3 tensor onto the tangent plane of unit n)
 inline void project_tangent(const double* n, const double S[3][3], double out[3][3]) {
     double P[3][3], T[3][3];

@@ -207,15 +207,7 @@ i64 vertex_groups(i64 nV, const i64* E, i64 nE, std::vector<std::int32_t>& label
 // Frames as tangent_frame, +z for non-finite normals.
 void transport_phases(const double* N, i64 nV, const i64* E, i64 nE, double* phase, int nt) {
     std::vector<double> fr((size_t)nV * 9);
-#ifdef IGL_HHJ_OPENMP
-#pragma omp parallel for schedule(static) num_threads(nt)
-#endif
-    for (i64 v = 0; v < nV; ++v) {
-        double* n = &fr[9 * v];
-        const bool fin = std::isfinite(N[3 * v]) && std::isfinite(N[3 * v + 1]) && std::isfinite(N[3 * v + 2]);
-        for (int a = 0; a < 3; ++a) n[a] = fin ? N[3 * v + a] : (a == 2 ? 1.0 : 0.0);
-        tangent_frame(n, n + 3, n + 6);
-    }
+    normal_frames(N, nV, fr.data(), nt);
 #ifdef IGL_HHJ_OPENMP
 #pragma omp parallel for schedule(static) num_threads(nt)
 #endif

@@ -180,15 +180,7 @@ void intrinsic_patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, con
     // vertex frames once (tangent_frame of N, +z where N is not finite), then the corner
     // components and cosines in one pass over faces (parallel: no scatter)
     std::vector<double> fr((size_t)nV * 9);
-#ifdef IGL_HHJ_OPENMP
-#pragma omp parallel for schedule(static) num_threads(nt)
-#endif
-    for (i64 v = 0; v < nV; ++v) {
-        double* n = &fr[9 * v];
-        const bool fin = std::isfinite(N[3 * v]) && std::isfinite(N[3 * v + 1]) && std::isfinite(N[3 * v + 2]);
-        for (int a = 0; a < 3; ++a) n[a] = fin ? N[3 * v + a] : (a == 2 ? 1.0 : 0.0);
-        tangent_frame(n, n + 3, n + 6);
-    }
+    normal_frames(N, nV, fr.data(), nt);
     std::vector<double> Y((size_t)nF * 9), cosine((size_t)nF * 3);
 #ifdef IGL_HHJ_OPENMP
 #pragma omp parallel for schedule(static) num_threads(nt)

@@ -73,18 +73,9 @@ def hessian_l2_error(field, surf, surface):
 
 
 def sequence(name, levels):
-    """The non-uniform sequences of the test suite (``tests/conftest.py``)."""
-    from .. import surfaces as su
-    if name == "ellipsoid":
-        s = su.Ellipsoid()
-        return s, su.mesh_sequence(*su.ellipsoid_coarse(s, subdivisions=2, amount=0.2), s, levels)
-    if name == "torus":
-        s = su.WalkerTorus()
-        return s, su.mesh_sequence(*su.torus_coarse(n_phi=16, n_t=8, amount=0.2), s, levels)
-    if name == "saddle":
-        s = su.WalkerSaddle()
-        return s, su.mesh_sequence(*su.graph_coarse(s, n=6, amount=0.2), s, levels)
-    raise ValueError(f"unknown surface {name!r}")
+    """The non-uniform sequences of the test suite (:func:`igl_hhj.surfaces.standard_sequence`)."""
+    from ..surfaces import standard_sequence
+    return standard_sequence(name, levels)
 
 
 def errors(name, order, degree, levels, boundary="none", data="walker"):

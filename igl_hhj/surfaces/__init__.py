@@ -20,11 +20,14 @@ from .meshing import (
     mesh_sequence,
     refine,
     square_grid,
+    STANDARD_SEQUENCES,
+    standard_sequence,
     torus_coarse,
 )
 
 __all__ = [
     "ImplicitSurface", "GraphSurface", "Sphere", "Ellipsoid", "WalkerTorus", "WalkerGenus3",
     "WalkerSaddle", "refine", "mesh_sequence", "jitter_tangentially", "icosphere",
-    "ellipsoid_coarse", "torus_coarse", "square_grid", "graph_coarse",
+    "ellipsoid_coarse", "torus_coarse", "square_grid", "graph_coarse", "standard_sequence",
+    "STANDARD_SEQUENCES",
 ]

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from .exact import Ellipsoid, GraphSurface, ImplicitSurface, Sphere, WalkerTorus
+from .exact import Ellipsoid, GraphSurface, ImplicitSurface, Sphere, WalkerSaddle, WalkerTorus
 
 __all__ = [
     "refine", "boundary_vertex_mask", "mesh_sequence", "jitter_tangentially", "icosphere",
@@ -181,3 +181,31 @@ def graph_coarse(surface: GraphSurface, n=4, amount=0.25, seed=0):
     """Perturbed coarse mesh of a graph surface over [0, 1]² (upward normals)."""
     P, F = square_grid(n, amount, seed)
     return surface.lift(P), F
+
+
+STANDARD_SEQUENCES = ("ellipsoid", "torus", "saddle", "sphere")
+"""Names of :func:`standard_sequence`."""
+
+
+def standard_sequence(name, levels):
+    """The non-uniform mesh sequences of the rate tests and of the Hessian benchmark:
+    ``(surface, [(V, F), ...])`` with ``levels`` meshes, each refined uniformly from a
+    perturbed coarse mesh and projected onto the exact surface.
+
+    ``"ellipsoid"`` (icosahedral, 2 subdivisions, 20 % perturbation), ``"torus"``
+    (Walker's torus from a 16 × 8 grid, 20 %), ``"saddle"`` (Walker's saddle graph, a 6 × 6
+    grid, 20 %), ``"sphere"`` (icosphere(1) jittered tangentially by 0.3 h)."""
+    if name == "ellipsoid":
+        s = Ellipsoid()
+        return s, mesh_sequence(*ellipsoid_coarse(s, subdivisions=2, amount=0.2), s, levels)
+    if name == "torus":
+        s = WalkerTorus()
+        return s, mesh_sequence(*torus_coarse(n_phi=16, n_t=8, amount=0.2), s, levels)
+    if name == "saddle":
+        s = WalkerSaddle()
+        return s, mesh_sequence(*graph_coarse(s, n=6, amount=0.2), s, levels)
+    if name == "sphere":
+        s = Sphere()
+        V, F = icosphere(1)
+        return s, mesh_sequence(jitter_tangentially(V, F, s, 0.3, seed=1), F, s, levels)
+    raise ValueError(f"unknown sequence {name!r}; one of {STANDARD_SEQUENCES}")
