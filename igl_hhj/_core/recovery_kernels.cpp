@@ -455,26 +455,11 @@ void solve5(double (&G)[5][5], double (&r)[5], double (&x)[5]) {
     }
 }
 
-// frame of boundary_estimation._frames: e1 = N x (the axis of the smallest |N_a|), e2 = N x e1
-void fit_frame(const double* n, double* e1, double* e2) {
-    int ax = 0;
-    double best = std::fabs(n[0]);
-    for (int a = 1; a < 3; ++a)
-        if (std::fabs(n[a]) < best || std::isnan(best)) { best = std::fabs(n[a]); ax = a; }
-    if (std::isnan(std::fabs(n[0]))) ax = 0;
-    double u[3] = {0.0, 0.0, 0.0};
-    u[ax] = 1.0;
-    cross3(n, u, e1);
-    const double l = std::sqrt(dot3(e1, e1));
-    for (int a = 0; a < 3; ++a) e1[a] /= l;
-    cross3(n, e1, e2);
-}
-
 // one fit at a vertex: (N out, ok)
 bool quadric_fit(const double* X, const double* xv, const i64* nb, i64 cnt, const double* n0, double scale,
                  double* nout) {
     double e1[3], e2[3];
-    fit_frame(n0, e1, e2);
+    tangent_frame(n0, e1, e2);      // boundary_estimation._frames (NaN normals: NaN frames)
     double G[5][5] = {}, r[5] = {};
     for (i64 q = 0; q < cnt; ++q) {
         const double* xc = X + 3 * nb[q];
