@@ -219,24 +219,37 @@ def heine_errors(field, surface_exact, degree=None):
             "Pi2": float(np.sqrt(np.sum(w * ((Pi - Pie) ** 2).sum((1, 2)))))}
 
 
-def run(labels=("5.1a", "5.1b", "5.1c", "5.1d"), degrees=(1, 2), levels=4, seed=100, jitter=0.3):
+def run(labels=("5.1a", "5.1b", "5.1c", "5.1d"), degrees=(1, 2), levels=4, seed=100, jitter=0.3,
+        meshes="jittered", tolerance=HEINE_GEOMETRIC_TOLERANCE):
     """dict (label, γ) → list of per-level error dicts (plus ``seconds``).
 
-    ``jitter`` re-perturbs every level (:func:`heine_sequence`): uniform refinement
-    alone leaves locally symmetric (parallelogram) patches on which degree 1
+    ``meshes="jittered"``: ``jitter`` re-perturbs every level (:func:`heine_sequence`): uniform
+    refinement alone leaves locally symmetric (parallelogram) patches on which degree 1
     superconverges (measured on (5.1a): E_K,2 EOC 1.75 without jitter), unlike
-    Heine's bisection meshes."""
-    from ..surfaces.heine import heine_sequence
+    Heine's bisection meshes.  ``meshes="heine"``: Heine's family, per γ
+    (:func:`~igl_hhj.surfaces.heine.heine_adaptive_sequence`: adaptive bisection of the
+    icosahedron until the geometric L2 error of the degree-γ surface is below
+    ``tolerance``, then global double bisection); each row also gets ``geometric_error``."""
+    from ..surfaces.heine import heine_adaptive_sequence, heine_sequence
+    if meshes not in ("jittered", "heine"):
+        raise ValueError(f"meshes must be 'jittered' or 'heine', got {meshes!r}")
     res = {}
     for lab in labels:
-        seq, s = heine_sequence(lab, levels, pre_refine=1, jitter=jitter, seed=seed)
+        if meshes == "jittered":
+            seq, s = heine_sequence(lab, levels, pre_refine=1, jitter=jitter, seed=seed)
         for g in degrees:
+            geo = None
+            if meshes == "heine":
+                seq, s, info = heine_adaptive_sequence(lab, levels, degree=g, tolerance=tolerance)
+                geo = info["geometric_error"]
             rows = []
-            for V, F in seq:
+            for i, (V, F) in enumerate(seq):
                 t0 = time.perf_counter()
                 surf = LagrangeSurface.from_projection(V, F, g, s.project, interpolant="nodal")
                 e = heine_errors(heine_weingarten(surf, g), s)
                 e["seconds"] = time.perf_counter() - t0
+                if geo is not None:
+                    e["geometric_error"] = geo[i]
                 rows.append(e)
             res[(lab, g)] = rows
     return res
@@ -254,19 +267,24 @@ def format_table(lab, g, rows):
     keys = ("K2", "Kinf", "H2", "Hinf", "Y2", "Pi2")
     hs = [r["h"] for r in rows]
     rates = {k: np.concatenate([[np.nan], eoc([r[k] for r in rows], hs)]) for k in keys}
+    geo = "geometric_error" in rows[0]
     lines = [f"## Heine ({lab}), degree γ = {g}", "",
-             "| h_max | #F | E_K,2 | E_K,∞ | E_H,2 | E_H,∞ | ‖Y−Y_h‖L2 | ‖Π−Π_h‖L2 | s |",
-             "|---|---|---|---|---|---|---|---|---|"]
+             "| h_max | #F | E_K,2 | E_K,∞ | E_H,2 | E_H,∞ | ‖Y−Y_h‖L2 | ‖Π−Π_h‖L2 | s |"
+             + (" ‖dist(·, Γ)‖L2 |" if geo else ""),
+             "|---|---|---|---|---|---|---|---|---|" + ("---|" if geo else "")]
     for i, r in enumerate(rows):
         cells = [f"{r[k]:.2g}" + ("" if not np.isfinite(rates[k][i]) else f" ({rates[k][i]:.2f})") for k in keys]
-        lines.append(f"| {r['h']:.3g} | {r['faces']} | " + " | ".join(cells) + f" | {r.get('seconds', 0):.1f} |")
+        lines.append(f"| {r['h']:.3g} | {r['faces']} | " + " | ".join(cells) + f" | {r.get('seconds', 0):.1f} |"
+                     + (f" {r['geometric_error']:.2g} |" if geo else ""))
     near = _paper_row_near(lab, g, hs[-1])
     last = PAPER_HEINE_TABLES.get(lab, {}).get(g, [None])[-1]
     fmt = lambda v: "" if v is None else f"{v:.2g}"            # noqa: E731
     for tag, pr in (("paper, nearest h", near), ("paper, last row", last)):
         if pr is not None:
             lines.append(f"| {tag} {pr[0]:.3g} | | " + " | ".join(
-                f"{fmt(pr[1 + 2 * j])} ({fmt(pr[2 + 2 * j])})" for j in range(4)) + " | | | |")
+                fmt(pr[1 + 2 * j]) + ("" if pr[2 + 2 * j] is None else f" ({fmt(pr[2 + 2 * j])})")
+                for j in range(4)) + " | | | |"
+                + (" |" if geo else ""))
     lines.append("")
     return "\n".join(lines)
 
@@ -288,11 +306,17 @@ def main(argv=None):
     ap.add_argument("--jitter", type=float, default=0.3,
                     help="re-perturbation of every level (0: plain uniform refinement)")
     ap.add_argument("--seed", type=int, default=100)
+    ap.add_argument("--meshes", choices=("jittered", "heine"), default="jittered",
+                    help="'jittered' (re-jittered icosphere sequences) or 'heine' (Heine §5: adaptive "
+                         "bisection until the geometric L2 error < --tolerance, then global double bisection)")
+    ap.add_argument("--tolerance", type=float, default=HEINE_GEOMETRIC_TOLERANCE,
+                    help="geometric L2 error ending the adaptive phase of --meshes heine (paper: 0.005)")
     ap.add_argument("--out", default=None,
                     help="folder to write heine_curved.md into (e.g. demos/images); default: print only")
     a = ap.parse_args(argv)
     t0 = time.perf_counter()
-    res = run(a.surfaces, a.degrees, a.levels, seed=a.seed, jitter=a.jitter)
+    res = run(a.surfaces, a.degrees, a.levels, seed=a.seed, jitter=a.jitter, meshes=a.meshes,
+              tolerance=a.tolerance)
     parts = [format_table(lab, g, rows) for (lab, g), rows in res.items()]
     for t in parts:
         print(t)
@@ -301,13 +325,21 @@ def main(argv=None):
     if a.out is not None:
         from pathlib import Path
         args = f"--levels {a.levels} --degrees {' '.join(map(str, a.degrees))}"
-        mesh = ("re-jittered icosphere sequences mapped onto the surfaces, jitter "
-                f"{a.jitter}, seed {a.seed}")
+        if a.meshes == "heine":
+            args += f" --meshes heine --tolerance {a.tolerance}"
+            mesh = (f"Heine's family: adaptive newest-vertex bisection of the icosahedron until the "
+                    f"geometric L2 error of the degree-γ surface is below {a.tolerance}, then global "
+                    "double bisection")
+            name = "heine_curved_bisection.md"
+        else:
+            mesh = ("re-jittered icosphere sequences mapped onto the surfaces, jitter "
+                    f"{a.jitter}, seed {a.seed}")
+            name = "heine_curved.md"
         out = Path(a.out)
         out.mkdir(parents=True, exist_ok=True)
-        (out / "heine_curved.md").write_text(HEADER.format(args=args, mesh=mesh) + "\n" + "\n".join(parts)
+        (out / name).write_text(HEADER.format(args=args, mesh=mesh) + "\n" + "\n".join(parts)
                                              + f"\nTotal {total:.0f} s on 2 shared cores.\n")
-        print(f"wrote {out / 'heine_curved.md'}")
+        print(f"wrote {out / name}")
 
 
 if __name__ == "__main__":
