@@ -188,38 +188,40 @@ def _bisect(P, F, marked_edges_of):
     P = np.asarray(P, dtype=np.float64)
     F = np.asarray(F, dtype=np.int64)
     want = marked_edges_of(F)
-    nV = len(P)
     # edges to split: refinement edges of wanted faces, closed under "a split edge of a face
     # forces the split of that face's refinement edge"
     key = lambda a, b: np.minimum(a, b) * (1 << 32) + np.maximum(a, b)   # noqa: E731
-    split = set(key(F[want, 1], F[want, 2]).tolist())
-    while True:
+    split = np.unique(key(F[want, 1], F[want, 2]))
+    while True:                                   # closure: a face holding a split edge splits its own
         E = np.stack([key(F[:, 1], F[:, 2]), key(F[:, 2], F[:, 0]), key(F[:, 0], F[:, 1])], 1)
-        hit = np.isin(E, np.fromiter(split, dtype=np.int64, count=len(split)))
+        hit = np.isin(E, split)
         need = hit.any(1) & ~hit[:, 0]
         if not need.any():
             break
-        split.update(E[need, 0].tolist())
-    mid = {}
+        split = np.union1d(split, E[need, 0])
+    mid_keys = np.zeros(0, dtype=np.int64)        # sorted edge keys → midpoint vertex ids
+    mid_ids = np.zeros(0, dtype=np.int64)
     while True:                                   # bisect until no face holds a split edge
         E0 = key(F[:, 1], F[:, 2])
-        todo = np.isin(E0, np.fromiter(split, dtype=np.int64, count=len(split)))
+        todo = np.isin(E0, split)
         if not todo.any():
             break
         a, b, c = F[todo, 0], F[todo, 1], F[todo, 2]
-        ek = E0[todo]
-        uk, inv = np.unique(ek, return_inverse=True)
-        ids = np.array([mid.get(int(k), -1) for k in uk], dtype=np.int64)
+        uk, first, inv = np.unique(E0[todo], return_index=True, return_inverse=True)
+        ids = np.full(len(uk), -1, dtype=np.int64)
+        if len(mid_keys):
+            pos = np.minimum(np.searchsorted(mid_keys, uk), len(mid_keys) - 1)
+            known = mid_keys[pos] == uk
+            ids[known] = mid_ids[pos[known]]
         new = ids < 0
         if new.any():
-            first = np.zeros(len(uk), dtype=np.int64)
-            first[inv[::-1]] = np.arange(len(ek))[::-1]
             M = 0.5 * (P[b[first[new]]] + P[c[first[new]]])
             M /= np.linalg.norm(M, axis=1, keepdims=True)
-            ids[new] = nV + np.arange(new.sum())
+            ids[new] = len(P) + np.arange(new.sum())
             P = np.concatenate([P, M])
-            nV += int(new.sum())
-            mid.update(zip(uk[new].tolist(), ids[new].tolist()))
+            order = np.argsort(np.concatenate([mid_keys, uk[new]]))
+            mid_keys = np.concatenate([mid_keys, uk[new]])[order]
+            mid_ids = np.concatenate([mid_ids, ids[new]])[order]
         m = ids[inv]
         # a split edge stays in ``split``: a face on its other side still holds it (as its
         # refinement edge once its own refinement edge is split) and reuses the midpoint
