@@ -239,7 +239,8 @@ def heine_adaptive_sequence(label, n_levels, degree=2, tolerance=0.005, max_adap
     the unit sphere and mapped onto the surface as :func:`heine_sequence`; the adaptive
     steps mark the faces carrying the largest local errors ``∫_T dist(x, Γ)²`` until they hold
     the fraction ``theta`` of the total (Dörfler marking).  The geometric error is measured on
-    the degree-``degree`` nodal interpolant (:class:`igl_hhj.curved.LagrangeSurface`).
+    the degree-``degree`` nodal interpolant (:class:`igl_hhj.curved.LagrangeSurface`); while
+    that interpolant folds (too coarse a mesh for the surface), every face is bisected.
 
     Returns
     -------
@@ -265,7 +266,10 @@ def heine_adaptive_sequence(label, n_levels, degree=2, tolerance=0.005, max_adap
 
     def geometric(P, F):
         V = _to_surface(label, surface, P)
-        surf = LagrangeSurface.from_projection(V, F, degree, surface.project, interpolant="nodal")
+        try:
+            surf = LagrangeSurface.from_projection(V, F, degree, surface.project, interpolant="nodal")
+        except ValueError:                        # too coarse: a curved element folds; refine all
+            return np.inf, np.ones(len(F))
         faces, bary, w = surf.quadrature()
         X = surf.points(faces, bary)
         d2 = ((X - surface.project(X)) ** 2).sum(1)
