@@ -168,7 +168,7 @@ def _quad_disk():
 def test_validation_errors():
     surf = _quad_disk()
     P, E = np.array(surf.nodes), np.array(surf.elements)
-    with pytest.raises(ValueError, match="3, 6 or 10 columns"):
+    with pytest.raises(ValueError, match="3, 6, 10 or 15 columns"):
         LagrangeSurface(P, E[:, :5])
     with pytest.raises(ValueError, match="out of range"):
         LagrangeSurface(P, np.where(E == E.max(), len(P), E))
