@@ -138,6 +138,41 @@ def test_lantern_m_sim_n2_with_paper_perturbation():
     assert 0.2 <= _rates(rows, hs, "u2_L2")[-1] <= 0.9
 
 
+def test_hemisphere_u2_does_not_converge_in_h1():
+    """Paper 001 §6.1: "We observe no convergence in the H1 norm of u2" (the theory controls
+    only its L2 norm).  The benchmark (seed 0, 5 levels) measures |u2 − I_h u2|_H1 = 35.9,
+    42.9, 55.9, 65.9, 72.1 (EOC −0.26, −0.38, −0.24, −0.13) while ‖u2 + Δu‖L2 converges
+    (EOC 0.89 on the last level)."""
+    rows, hs = _hemisphere_rows("full")
+    r = _rates(rows, hs, "u2_H1")
+    assert (r <= 0.0).all(), f"u2 H1 EOC {r}"
+    assert rows[-1]["u2_H1"] > rows[0]["u2_H1"]
+    assert _rates(rows, hs, "u2_L2")[-1] >= 0.7
+
+
+def test_lantern_normal_perturbation_is_radial_and_area_stalls():
+    """The second reading of "perturbed on the order of (mean edge length)²": every vertex
+    off the cylinder by exactly ± ℓ̄² along the normal; on m ~ n² (around spacing ~ ℓ̄²) the
+    area stops converging further off than with the cube perturbation (benchmark, 101k
+    vertices: 6.583 against 6.388 and 2π = 6.283)."""
+    V0, F = schwarz_lantern(48, 5)
+    V, F2 = schwarz_lantern(48, 5, perturbation=1.0, seed=3, mode="normal")
+    np.testing.assert_array_equal(F, F2)
+    E = igl.edges(F)
+    lbar = np.linalg.norm(V0[E[:, 0]] - V0[E[:, 1]], axis=1).mean()
+    np.testing.assert_allclose(np.abs(np.hypot(V[:, 0], V[:, 1]) - 1.0), lbar ** 2, rtol=1e-12)
+    np.testing.assert_allclose(V[:, 2], V0[:, 2], atol=1e-15)
+    np.testing.assert_allclose(np.arctan2(V[:, 1], V[:, 0]), np.arctan2(V0[:, 1], V0[:, 0]), atol=1e-12)
+    area = {mode: [igl.doublearea(V, F).sum() / 2 for V, F, _, _ in
+                   lantern_sequence("m~n^2", 4, perturbation=1.0, seed=0, mode=mode)]
+            for mode in ("cube", "normal")}
+    for mode, a in area.items():
+        assert abs(a[-1] - 2 * np.pi) > 0.7 * abs(a[-2] - 2 * np.pi), (mode, a)
+    assert area["normal"][-1] - 2 * np.pi > 2 * (area["cube"][-1] - 2 * np.pi), area
+    with pytest.raises(ValueError, match="mode must be one of"):
+        schwarz_lantern(12, 3, perturbation=1.0, mode="sideways")
+
+
 def test_lantern_navier_rate():
     """u = cos φ sin(πz): u = Δu = 0 at z = 0, 1 (bc="navier")."""
     P = LanternProblem("navier")
@@ -404,9 +439,15 @@ def test_benchmark_run_tiny(tmp_path):
     """The benchmark's run() on tiny sizes: tables, EOCs and the perf comparison."""
     from igl_hhj.benchmarks.biharmonic_convergence import run
     pytest.importorskip("matplotlib")
-    res = run(levels=2, cases=["hemisphere", "lantern m~n"], out=str(tmp_path), perf=True,
+    res = run(levels=2, cases=["hemisphere", "lantern m~n", "lantern m~n, navier", "hemisphere, navier data",
+                               "lantern m~n^2, normal"], out=str(tmp_path), perf=True,
               perf_max_vertices=700, perf_rings=3, progress=False, verbose=False)
-    assert set(res["convergence"]) == {"hemisphere", "lantern m~n"}
+    assert set(res["convergence"]) == {"hemisphere", "lantern m~n", "lantern m~n, navier",
+                                       "hemisphere, navier data", "lantern m~n^2, normal"}
+    md = open(os.path.join(str(tmp_path), "biharmonic_convergence.md")).read()
+    assert "‖∇(u2-I_h u2)‖L2" in md and "### lantern m~n, navier" in md
+    assert res["eoc"]["hemisphere, navier data"]["u1_L2"][0] > 1.5
+    assert res["eoc"]["lantern m~n, navier"]["u1_L2"][0] > 1.0
     assert len(res["eoc"]["hemisphere"]["u1_L2"]) == 1 and res["eoc"]["hemisphere"]["u1_L2"][0] > 1.5
     assert all(os.path.exists(p) for p in res["files"])
     perf = res["perf"]

@@ -5,9 +5,11 @@ Run as ``python -m igl_hhj.benchmarks.biharmonic_convergence [--levels 5] [--per
 
 Convergence part (§6.1, §6.2, §5.3): for the clamped hemisphere (Fig. 2), the
 clamped spherical cap θ ≤ π/4 (Fig. 3), the Schwarz lantern (Fig. 4: m ~ n, and
-the degenerate regimes m ~ n² and n ~ m²) and the closed sphere (Thm 5.4), the
-L2 and H1 errors of u1 and the L2 error of u2 against h on non-uniform mesh
-sequences, with EOCs printed beside the paper's proven / observed rates;
+the degenerate regimes m ~ n² and n ~ m²; m ~ n² with both readings of "perturbed
+on the order of (mean edge length)²": a random vector of the cube ``ℓ̄² [-1, 1]³`` or
+``± ℓ̄²`` along the normal), the closed sphere (Thm 5.4), and Navier boundary
+conditions (lantern ``u = cos φ sin πz``; hemisphere with inhomogeneous data), the
+L2 and H1 errors of u1 and of u2 against h on non-uniform mesh sequences, with EOCs printed beside the paper's proven / observed rates;
 a log-log PNG and a CSV of all numbers.
 
 Performance part (``--perf``): setup + solve time against #V on clamped
@@ -54,25 +56,34 @@ from ..surfaces.biharmonic_problems import (
 PAPER = {
     "hemisphere": {"u1_L2": "1 (Thm 5.3)", "u1_H1": "3/4 (Cor 5.1)", "u2_L2": "1/2 (Thm 5.2)",
                    "observed": "Fig. 2: convergence 'with rates at least as good as predicted'; "
-                               "no H1 convergence of u2"},
+                               "'no convergence in the H1 norm of u2' (column ‖∇(u2-I_h u2)‖L2)"},
     "cap": {"u1_L2": "-", "u1_H1": "-", "u2_L2": "-",
             "observed": "Fig. 3: 'we still empirically observe convergence' ((C2) relaxed)"},
     "lantern m~n": {"u1_L2": "-", "u1_H1": "-", "u2_L2": "-",
                     "observed": "Fig. 4: converges, 'we even observe a rate of h^2'"},
     "lantern m~n^2": {"u1_L2": "-", "u1_H1": "-", "u2_L2": "-",
-                      "observed": "Fig. 4: 'ceases to converge' (surface area does not converge)"},
+                      "observed": "Fig. 4: 'ceases to converge' (surface area does not converge); "
+                                  "perturbation c ℓ̄² ξ, ξ uniform in [-1, 1]³"},
+    "lantern m~n^2, normal": {"u1_L2": "-", "u1_H1": "-", "u2_L2": "-",
+                              "observed": "Fig. 4: 'ceases to converge'; the same meshes perturbed "
+                                          "along the normal by ± ℓ̄² (the other reading of the wording)"},
     "lantern n~m^2": {"u1_L2": "-", "u1_H1": "-", "u2_L2": "-",
                       "observed": "(not in the paper; the classic Schwarz regime: area diverges)"},
     "closed sphere": {"u1_L2": "2 (Thm 5.4)", "u1_H1": "1 (Thm 5.4)", "u2_L2": "2 (Thm 5.4)",
                       "observed": "(§5.3, no experiment)"},
+    "lantern m~n, navier": {"u1_L2": "-", "u1_H1": "-", "u2_L2": "-",
+                            "observed": "(not in the paper: Navier u = Δu = 0, u = cos φ sin πz)"},
+    "hemisphere, navier data": {"u1_L2": "-", "u1_H1": "-", "u2_L2": "-",
+                                "observed": "(not in the paper: inhomogeneous Navier data g = u, w = -Δu)"},
 }
 
 EXACT_AREA = {"hemisphere": 2 * np.pi, "cap": 2 * np.pi * (1 - np.cos(np.pi / 4)),
-              "lantern m~n": 2 * np.pi, "lantern m~n^2": 2 * np.pi, "lantern n~m^2": 2 * np.pi,
-              "closed sphere": 4 * np.pi}
+              "lantern m~n": 2 * np.pi, "lantern m~n^2": 2 * np.pi, "lantern m~n^2, normal": 2 * np.pi,
+              "lantern n~m^2": 2 * np.pi, "closed sphere": 4 * np.pi, "lantern m~n, navier": 2 * np.pi,
+              "hemisphere, navier data": 2 * np.pi}
 
-KEYS = [("u1_L2", "‖u1-u‖L2"), ("u1_H1", "|u1-I_h u|H1"), ("u1_H1_grad", "‖∇(u1-u)‖L2"),
-        ("u2_L2", "‖u2+Δu‖L2")]
+KEYS = [("u1_L2", "‖u1-u‖L2"), ("u1_H1", "‖∇(u1-I_h u)‖L2"), ("u1_H1_grad", "‖∇(u1-u)‖L2"),
+        ("u2_L2", "‖u2+Δu‖L2"), ("u2_H1", "‖∇(u2-I_h u2)‖L2")]
 
 
 def _cases(levels, seed):
@@ -82,15 +93,21 @@ def _cases(levels, seed):
     C = SphericalCapProblem(np.pi / 4)
     S = SphereHarmonicsProblem()
     Lp = LanternProblem()
-    lant = lambda regime, n: [(V, F) for V, F, _, _ in  # noqa: E731
-                              lantern_sequence(regime, n, perturbation=1.0, seed=seed)]
+    Ln = LanternProblem("navier")
+    Hn = SphereHarmonicsProblem(bc="clamped")     # hemisphere meshes; Navier data passed below
+    lant = lambda regime, n, mode="cube": [(V, F) for V, F, _, _ in  # noqa: E731
+                                           lantern_sequence(regime, n, perturbation=1.0, seed=seed, mode=mode)]
     return [
         ("hemisphere", H, {}, lambda: H.meshes(L, seed=seed)),
         ("cap", C, {}, lambda: C.meshes(L, seed=seed)),
         ("lantern m~n", Lp, {}, lambda: lant("m~n", L)),
         ("lantern m~n^2", Lp, {}, lambda: lant("m~n^2", min(L, 5))),
+        ("lantern m~n^2, normal", Lp, {}, lambda: lant("m~n^2", min(L, 5), "normal")),
         ("lantern n~m^2", Lp, {}, lambda: lant("n~m^2", min(L, 4))),
         ("closed sphere", S, {"bc": "closed", "project_mean": True}, lambda: S.meshes(L, seed=seed)),
+        ("lantern m~n, navier", Ln, {"bc": "navier"}, lambda: lant("m~n", L)),
+        ("hemisphere, navier data", Hn, {"bc": "navier", "g": Hn.u, "w": Hn.u2},
+         lambda: Hn.meshes(L, seed=seed)),
     ]
 
 
@@ -148,8 +165,14 @@ def _plot(results, path):
     axes.ravel()[0].legend(fontsize=7)
     fig.suptitle("Mixed P1 biharmonic (Stein et al., §6): errors vs h", fontsize=11)
     fig.tight_layout()
-    fig.savefig(path, dpi=85)
+    fig.set_dpi(85)
+    fig.canvas.draw()
+    image = np.asarray(fig.canvas.buffer_rgba())
     plt.close(fig)
+    from ..viewer import _save_png
+    if not _save_png(path, image):                        # Pillow missing: matplotlib's RGB PNG
+        import matplotlib.image
+        matplotlib.image.imsave(path, image)
 
 
 # ---------------------------------------------------------------- performance

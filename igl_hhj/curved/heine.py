@@ -25,14 +25,14 @@ __all__ = ["LagrangeSpace", "heine_weingarten"]
 
 
 class LagrangeSpace:
-    """Continuous Lagrange space of degree γ ∈ {1, 2, 3} on a LagrangeSurface.
+    """Continuous Lagrange space of degree γ ∈ {1, 2, 3, 4} on a LagrangeSurface.
 
     ``elements`` (#F, (γ+1)(γ+2)/2): DOFs per face in gmsh order (vertices as
-    the surface's corner nodes, then γ − 1 per unique edge, then one per face)."""
+    the surface's corner nodes, then γ − 1 per unique edge, then (γ−1)(γ−2)/2 per face)."""
 
     def __init__(self, surface, degree):
-        if degree not in (1, 2, 3):
-            raise ValueError(f"Lagrange degree must be 1, 2 or 3, got {degree!r}")
+        if degree not in (1, 2, 3, 4):
+            raise ValueError(f"Lagrange degree must be 1, 2, 3 or 4, got {degree!r}")
         self.surface, self.degree = surface, int(degree)
         mesh = surface.mesh
         nV, nE, nF = surface.n_nodes, mesh.n_edges, mesh.n_faces   # corner DOFs = corner node ids
@@ -47,9 +47,10 @@ class LagrangeSpace:
             ids = nV + e[:, None] * (g - 1) + np.arange(g - 1)[None]
             el[:, slots[j]] = np.where(fw[:, None], ids, ids[:, ::-1])
         n = nV + nE * (g - 1)
-        if g == 3:
-            el[:, 9] = n + np.arange(nF)
-            n += nF
+        ni = (g - 1) * (g - 2) // 2                  # face-interior DOFs
+        if ni:
+            el[:, 3 + 3 * (g - 1):] = n + ni * np.arange(nF)[:, None] + np.arange(ni)[None]
+            n += ni * nF
         used = np.zeros(n, dtype=bool)
         used[el.ravel()] = True
         self.elements, self.n_dofs, self.used = el, n, used
@@ -66,7 +67,7 @@ def heine_weingarten(surface, degree=None, quad_degree=None):
     Parameters
     ----------
     surface : LagrangeSurface (order m)
-    degree : {1, 2, 3}, optional, γ.
+    degree : {1, 2, 3, 4}, optional, γ.
 
     Returns
     -------

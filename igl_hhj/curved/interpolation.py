@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..mesh import TriangleMesh
-from .reference import edge_node_slots, lagrange_basis, line_quadrature, triangle_quadrature
+from .reference import edge_node_slots, lagrange_basis, lagrange_nodes, line_quadrature, triangle_quadrature
 
 __all__ = ["projected_nodes", "mapped_nodes", "edge_moment_matrices", "modified_interpolant"]
 
@@ -64,10 +64,13 @@ def mapped_nodes(mesh, order, element_map, interpolant="walker"):
     """Nodes and elements of Γ^m for an element map ``element_map(faces, bary) -> (n, 3)``:
     the exact map F_T of Walker §3.1 from the flat triangles of ``mesh`` onto Γ
     (continuous across edges), interpolated by 𝓘_h^{1,m} (eq. 4.14) or nodally."""
-    if order not in (1, 2, 3):
-        raise ValueError(f"order must be 1, 2 or 3, got {order!r}")
+    if order not in (1, 2, 3, 4):
+        raise ValueError(f"order must be 1, 2, 3 or 4, got {order!r}")
     if interpolant not in ("walker", "nodal"):
         raise ValueError(f"interpolant must be 'walker' or 'nodal', got {interpolant!r}")
+    if order == 4 and interpolant == "walker":
+        raise ValueError("Walker's modified interpolant (eq. 4.14) is implemented for order m <= 3; "
+                         "order 4 (Heine's degree γ = 4) needs interpolant='nodal'")
     if not callable(element_map):
         raise TypeError("the element map must be callable (faces, bary) -> points")
     Ff = mesh.F
@@ -130,6 +133,12 @@ def mapped_nodes(mesh, order, element_map, interpolant="walker"):
         ids = nV + e[:, None] * (order - 1) + np.arange(order - 1)[None]
         ids = np.where(fw[:, None], ids, ids[:, ::-1])
         elements[:, slots[j]] = ids
+    if order == 4:                           # 3 interior nodes per face, nodal (gmsh triangle15)
+        c0 = nV + nE * (order - 1)
+        elements[:, 12:] = c0 + 3 * np.arange(nF)[:, None] + np.arange(3)[None]
+        xi = lagrange_nodes(4)[12:]
+        lam = np.column_stack([1 - xi.sum(1), xi])
+        nodes.append(fmap(np.repeat(np.arange(nF), 3), np.tile(lam, (nF, 1))))
     if order == 3:
         c0 = nV + nE * (order - 1)
         elements[:, 9] = c0 + np.arange(nF)

@@ -43,8 +43,10 @@ def lagrange_nodes(order):
             pts.append((1 - t) * CORNERS[a] + t * CORNERS[b])
     if order == 3:
         pts.append(np.array([1.0 / 3.0, 1.0 / 3.0]))
-    elif order > 3:
-        raise ValueError(f"orders up to 3 are supported, got {order}")
+    elif order == 4:                     # gmsh triangle15: the inner triangle's corners
+        pts += [np.array([0.25, 0.25]), np.array([0.5, 0.25]), np.array([0.25, 0.5])]
+    elif order > 4:
+        raise ValueError(f"orders up to 4 are supported, got {order}")
     return np.array(pts)
 
 

@@ -18,7 +18,7 @@ from .reference import edge_node_slots, lagrange_basis, triangle_quadrature
 
 __all__ = ["LagrangeSurface", "ElementGeometry"]
 
-_ORDER_OF = {3: 1, 6: 2, 10: 3}
+_ORDER_OF = {3: 1, 6: 2, 10: 3, 15: 4}
 
 
 class ElementGeometry:
@@ -101,9 +101,9 @@ class LagrangeSurface:
         except Exception as exc:
             raise TypeError(f"elements must be array-like: {exc}") from None
         if E.ndim != 2:
-            raise ValueError(f"elements must be a 2-D array (#F, 3/6/10), got shape {E.shape}")
+            raise ValueError(f"elements must be a 2-D array (#F, 3/6/10/15), got shape {E.shape}")
         if E.shape[1] not in _ORDER_OF:
-            raise ValueError(f"elements must have 3, 6 or 10 columns (triangle3/6/10, order 1/2/3), "
+            raise ValueError(f"elements must have 3, 6, 10 or 15 columns (triangle3/6/10/15, order 1/2/3/4), "
                              f"got {E.shape[1]}")
         if E.shape[0] == 0:
             raise ValueError("elements is empty")

@@ -11,7 +11,8 @@ Degree k on planar triangulations with a metric::
 
     g_h = igl_hhj.regge.interpolate(P, F, metric, k)        # canonical interpolant
     K_h = igl_hhj.regge.lift_gauss_curvature(g_h, degree=k, dirichlet=..., ...)
-    K_h(faces, bary), K_h.dofs, K_h.l2_error(K_exact), K_h.h_minus1_error(K_exact)
+    K_h(faces, bary), K_h.dofs, K_h.l2_error(K_exact), K_h.h_minus1_error(K_exact),
+    K_h.h1_error(K_exact, grad_K_exact), K_h.l2_error(K_omega_exact, times_omega_h=True)
 """
 from .curvature import (LiftedCurvature, corner_angles, edge_geodesic_curvature,
                         gauss_curvature_functional, lift_gauss_curvature,

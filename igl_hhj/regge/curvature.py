@@ -206,7 +206,8 @@ def _edge_mask(tri, spec, name):
 
 
 class LiftedCurvature:
-    """The lifted Gauss curvature ``K_h ∈ V_h^p`` (or ``K_h ω_h`` if densitized).
+    """The lifted Gauss curvature ``K_h ∈ V_h^p`` (or, if ``densitized``, the Euclidean-mass
+    lifting ``(Kω)_h``, the Euclidean L² projection of ``K_h ω_h``).
 
     Attributes
     ----------
@@ -244,27 +245,83 @@ class LiftedCurvature:
         """``∫ K_h ω_h`` (or ``∫ K_h ω_h dx`` when densitized) = ``1ᵀ M K_h``."""
         return float(self.mass.sum(axis=0) @ self.dofs)
 
-    def l2_error(self, exact, quad_degree=None):
-        """Euclidean ``‖K_h - K̄‖_{L²(Ω)}`` for ``exact: (N, 2) -> (N,)``."""
+    def _error_at(self, exact, pts, times_omega_h, gradient=None):
+        """Error ``ē - e_h`` at reference ``pts`` on every element, ``(#F, n)``, where
+        ``e_h = K_h`` or ``K_h ω_h`` (``times_omega_h``); with ``gradient`` also the
+        physical gradient of the error ``(#F, n, 2)``."""
         tri = self.space.tri
-        pts, w = triangle_rule(quad_degree or 2 * self.degree + 10)
+        if times_omega_h and self.densitized:
+            raise ValueError("times_omega_h=True multiplies the pure lifting K_h by ω_h; this "
+                             "lifting is already densitized (lift with densitized=False)")
         X = tri.to_physical(pts)
         ex = _call_scalar(exact, X.reshape(-1, 2), "exact").reshape(X.shape[:2])
-        d = ex - self.reference_values(pts)
+        if gradient is None:
+            phi = self.space.basis(pts)
+        else:
+            phi, dphi = self.space.basis(pts, derivatives=True)
+        loc = self.dofs[self.space.cell_dofs]
+        val = np.einsum("qa,fa->fq", phi, loc)
+        Jinv = np.linalg.inv(tri.J)                                   # ∇_x = J^{-T} ∇̂
+        if gradient is not None:
+            grad = np.einsum("fki,qak,fa->fqi", Jinv, dphi, loc)
+        if times_omega_h:
+            # ω_h = √det g_h = √det ĝ / det J (ĝ = Jᵀ g_h J, affine elements)
+            g, dg = self.metric.reference_values(pts, derivatives=1)
+            det = g[..., 0, 0] * g[..., 1, 1] - g[..., 0, 1] ** 2
+            om = np.sqrt(det) / tri.detJ[:, None]
+            if gradient is not None:
+                # ∂_a √det ĝ = ½ √det ĝ tr(ĝ⁻¹ ∂_a ĝ)
+                ginv = np.linalg.inv(g)
+                dom_ref = 0.5 * om[..., None] * np.einsum("fqij,fqaji->fqa", ginv, dg)
+                grad = om[..., None] * grad + val[..., None] * np.einsum("fki,fqk->fqi", Jinv, dom_ref)
+            val = val * om
+        if gradient is None:
+            return ex - val
+        gex = np.asarray(gradient(X.reshape(-1, 2)), dtype=np.float64)
+        if gex.shape != (X.shape[0] * X.shape[1], 2):
+            raise ValueError(f"exact_gradient must map (N, 2) points to shape (N, 2), got {gex.shape}")
+        _check_finite_values(gex, X.reshape(-1, 2), "exact_gradient")
+        return ex - val, gex.reshape(X.shape[:2] + (2,)) - grad
+
+    def l2_error(self, exact, quad_degree=None, *, times_omega_h=False):
+        """Euclidean ``‖K_h - K̄‖_{L²(Ω)}`` for ``exact: (N, 2) -> (N,)``.
+
+        ``times_omega_h=True``: the densitized error ``‖K_h ω_h - K̄ ω̄‖_{L²}`` of
+        Theorem 3.1 / Corollary 3.2 (``ω_h = √det g_h``, pointwise product with the
+        pure lifting; pass ``exact = K̄ ω̄``)."""
+        tri = self.space.tri
+        pts, w = triangle_rule(quad_degree or 2 * self.degree + 10)
+        d = self._error_at(exact, pts, times_omega_h)
         return float(np.sqrt(np.einsum("q,fq,f->", w, d * d, tri.detJ)))
 
-    def h_minus1_error(self, exact, degree=None, quad_degree=None):
+    def h1_error(self, exact, exact_gradient, quad_degree=None, *, times_omega_h=False):
+        """Elementwise (broken) ``‖K_h - K̄‖_{H¹_h} = (Σ_T ‖K_h - K̄‖²_{H¹(T)})^{1/2}``,
+        the ``r = 1`` norm of Corollary 3.9 (``times_omega_h``: of ``K_h ω_h - K̄ ω̄``,
+        Corollary 3.2; rate ``k`` for ``K_h ∈ V_h^k``).
+
+        Parameters
+        ----------
+        exact : callable ``(N, 2) -> (N,)``
+        exact_gradient : callable ``(N, 2) -> (N, 2)``, Euclidean gradient of ``exact``
+        """
+        if not callable(exact_gradient):
+            raise TypeError("exact_gradient must be callable (N, 2) -> (N, 2)")
+        tri = self.space.tri
+        pts, w = triangle_rule(quad_degree or 2 * self.degree + 10)
+        d, dd = self._error_at(exact, pts, times_omega_h, gradient=exact_gradient)
+        return float(np.sqrt(np.einsum("q,fq,f->", w, d * d + (dd * dd).sum(-1), tri.detJ)))
+
+    def h_minus1_error(self, exact, degree=None, quad_degree=None, *, times_omega_h=False):
         """``‖K̄ - K_h‖_{H⁻¹} ≈ ‖w‖_{H¹}`` (full norm), ``w ∈ V_h^{p+2}`` (default) solving
-        ``-Δw = K̄ - K_h``, ``w = 0`` on ``∂Ω`` (Gopalakrishnan et al. 2024, §4)."""
+        ``-Δw = K̄ - K_h``, ``w = 0`` on ``∂Ω`` (Gopalakrishnan et al. 2024, §4);
+        ``times_omega_h``: of ``K̄ ω̄ - K_h ω_h`` (Theorem 3.1)."""
         import scipy.sparse.linalg as spla
         tri = self.space.tri
         P = self.degree + 2 if degree is None else _check_int(degree, "degree", 1, MAX_DEGREE)
         W = LagrangeSpace(tri, P)
         qd = quad_degree or 2 * P + 10
         pts, w = triangle_rule(qd)
-        X = tri.to_physical(pts)
-        ex = _call_scalar(exact, X.reshape(-1, 2), "exact").reshape(X.shape[:2])
-        d = ex - self.reference_values(pts)
+        d = self._error_at(exact, pts, times_omega_h)
         b = W.assemble_vector(np.einsum("q,fq,qa,f->fa", w, d, W.basis(pts), tri.detJ))
         A = W.stiffness_matrix()
         M = W.mass_matrix()
@@ -310,8 +367,11 @@ def lift_gauss_curvature(g_h, degree=None, *, dirichlet=None, dirichlet_values=N
 
     with ``K̃ω`` of eq. (2.5) (element curvature, geodesic-curvature jumps,
     angle deficits ``2π - Σθ`` at all vertices).  ``densitized=True`` uses the
-    Euclidean mass matrix instead of the ``ω_h``-weighted one and returns the
-    lifting of ``K ω`` (Remark 3.3).
+    Euclidean mass matrix instead of the ``ω_h``-weighted one: ``(Kω)_h ∈ V_h^p`` with
+    ``∫ (Kω)_h u dx = K̃ω(g_h)(u)``, the Euclidean L² projection of ``K_h ω_h``.  This is
+    *not* the densitized quantity of Theorem 3.1 / Corollary 3.2, which is the pointwise
+    product ``K_h ω_h`` of the default lifting with ``ω_h = √det g_h``: measure that one
+    with ``l2_error(K̄ω̄, times_omega_h=True)`` (also ``h_minus1_error``, ``h1_error``).
 
     Parameters
     ----------

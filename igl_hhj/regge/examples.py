@@ -10,7 +10,8 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["structured_square", "graph_metric", "graph_gauss_curvature",
-           "graph_boundary_geodesic_curvature", "graph_dirichlet", "graph_densitized_curvature", "sphere_metric",
+           "graph_boundary_geodesic_curvature", "graph_dirichlet", "graph_densitized_curvature",
+           "graph_gauss_curvature_gradient", "graph_densitized_curvature_gradient", "sphere_metric",
            "euclidean_metric", "polynomial_metric"]
 
 
@@ -112,3 +113,31 @@ def graph_densitized_curvature(X):
     X = np.asarray(X, dtype=np.float64)
     fx, fy = _fx(X[:, 0]), _fx(X[:, 1])
     return graph_gauss_curvature(X) * np.sqrt(1 + fx * fx + fy * fy)
+
+
+def _graph_D(x, y):
+    """``D = 9 + x²(x²-3)² + y²(y²-3)² = 9 det ḡ`` and ``∂_x D, ∂_y D``."""
+    D = 9 + x * x * (x * x - 3) ** 2 + y * y * (y * y - 3) ** 2
+    return D, 6 * x * (x * x - 3) * (x * x - 1), 6 * y * (y * y - 3) * (y * y - 1)
+
+
+def graph_gauss_curvature_gradient(X):
+    """``∇K̄`` of :func:`graph_gauss_curvature`; ``(N, 2) -> (N, 2)`` (for the H¹_h error,
+    Corollary 3.9)."""
+    x, y = np.asarray(X, dtype=np.float64).T
+    D, Dx, Dy = _graph_D(x, y)
+    A, B = 1 - x * x, 1 - y * y
+    return np.stack([81 * B * (-2 * x * D - 2 * A * Dx) / D ** 3,
+                     81 * A * (-2 * y * D - 2 * B * Dy) / D ** 3], 1)
+
+
+def graph_densitized_curvature_gradient(X):
+    """``∇(K̄ ω̄)`` of :func:`graph_densitized_curvature` (``ω̄ = √D / 3``); ``(N, 2) -> (N, 2)``
+    (for the H¹_h error of Corollary 3.2)."""
+    X = np.asarray(X, dtype=np.float64)
+    x, y = X.T
+    D, Dx, Dy = _graph_D(x, y)
+    om = np.sqrt(D) / 3.0
+    K = graph_gauss_curvature(X)
+    dK = graph_gauss_curvature_gradient(X)
+    return dK * om[:, None] + K[:, None] * np.stack([Dx, Dy], 1) / (6.0 * np.sqrt(D))[:, None]

@@ -128,7 +128,10 @@ def cap_mesh(theta0=np.pi / 2, levels=0, rings=3, amount=0.25, seed=0):
     return refine(V, F, to_sphere, levels, project_boundary=to_circle)
 
 
-def schwarz_lantern(m, n, perturbation=0.0, seed=0, radius=1.0, height=1.0):
+LANTERN_PERTURBATIONS = ("cube", "normal")
+
+
+def schwarz_lantern(m, n, perturbation=0.0, seed=0, radius=1.0, height=1.0, mode="cube"):
     """Schwarz lantern: ``n`` rings of ``m`` vertices on the cylinder
     ``x² + y² = radius²``, ``z ∈ [0, height]``, each ring rotated by half a step
     against the previous one, 2m(n-1) triangles, outward normals.
@@ -140,11 +143,15 @@ def schwarz_lantern(m, n, perturbation=0.0, seed=0, radius=1.0, height=1.0):
     n : int ≥ 2
         Vertices along the axis (rings).
     perturbation : float
-        Every vertex moves by ``perturbation · ℓ̄² · ξ`` with ``ℓ̄`` the mean edge
-        length and ``ξ`` uniform in [-1, 1]³ (Stein et al. 2022, Fig. 4: "perturbed on
-        the order of (mean edge length)²"); boundary rings stay in their planes.
+        Size ``c`` of the perturbation ``c · ℓ̄²`` with ``ℓ̄`` the mean edge length
+        (Stein et al. 2022, Fig. 4: "perturbed on the order of (mean edge length)²");
+        boundary rings stay in their planes.
     seed : int
         Seed of the perturbation.
+    mode : {"cube", "normal"}
+        ``"cube"``: every vertex moves by ``c ℓ̄² ξ``, ``ξ`` uniform in [-1, 1]³;
+        ``"normal"``: every vertex moves along the cylinder's normal (radially) by
+        ``± c ℓ̄²``, random signs (the whole perturbation off the surface, none within).
 
     Returns
     -------
@@ -153,6 +160,8 @@ def schwarz_lantern(m, n, perturbation=0.0, seed=0, radius=1.0, height=1.0):
     for name, val, lo in (("m", m, 3), ("n", n, 2)):
         if not (isinstance(val, (int, np.integer)) and val >= lo):
             raise ValueError(f"{name} must be an integer >= {lo}, got {val!r}")
+    if mode not in LANTERN_PERTURBATIONS:
+        raise ValueError(f"mode must be one of {LANTERN_PERTURBATIONS}, got {mode!r}")
     m, n = int(m), int(n)
     j, i = np.meshgrid(np.arange(n), np.arange(m), indexing="ij")
     phi = 2 * np.pi * (i + 0.5 * j) / m
@@ -174,13 +183,18 @@ def schwarz_lantern(m, n, perturbation=0.0, seed=0, radius=1.0, height=1.0):
         E = np.unique(np.sort(E, axis=1), axis=0)
         lbar = np.linalg.norm(V[E[:, 0]] - V[E[:, 1]], axis=1).mean()
         rng = np.random.default_rng(seed)
-        d = perturbation * lbar ** 2 * rng.uniform(-1, 1, V.shape)
+        if mode == "cube":
+            d = perturbation * lbar ** 2 * rng.uniform(-1, 1, V.shape)
+        else:
+            r = np.hypot(V[:, 0], V[:, 1])[:, None]
+            radial = np.column_stack([V[:, :2] / r, np.zeros(len(V))])
+            d = perturbation * lbar ** 2 * rng.choice([-1.0, 1.0], len(V))[:, None] * radial
         d[(j.ravel() == 0) | (j.ravel() == n - 1), 2] = 0.0
         V = V + d
     return V, F
 
 
-def lantern_sequence(regime="m~n", n_levels=4, perturbation=1.0, seed=0, base=2):
+def lantern_sequence(regime="m~n", n_levels=4, perturbation=1.0, seed=0, base=2, mode="cube"):
     """Schwarz-lantern sequences with ``h`` roughly halving per level.
 
     Parameters
@@ -191,6 +205,9 @@ def lantern_sequence(regime="m~n", n_levels=4, perturbation=1.0, seed=0, base=2)
         base 2π/m ≪ height); ``"n~m^2"``: m = 2·base·2^k, n - 1 = m²/2 (flat,
         obtuse triangles whose normals do not converge; the surface area of the
         lantern does not converge, Morvan 2008 §3.1.3).
+
+    mode : {"cube", "normal"}
+        Direction of the perturbation (:func:`schwarz_lantern`).
 
     Returns
     -------
@@ -208,7 +225,7 @@ def lantern_sequence(regime="m~n", n_levels=4, perturbation=1.0, seed=0, base=2)
             n = m * m // 2 + 1
         else:
             raise ValueError(f"regime must be 'm~n', 'm~n^2' or 'n~m^2', got {regime!r}")
-        V, F = schwarz_lantern(m, n, perturbation=perturbation, seed=seed + k)
+        V, F = schwarz_lantern(m, n, perturbation=perturbation, seed=seed + k, mode=mode)
         out.append((V, F, m, n))
     return out
 
@@ -454,9 +471,9 @@ class LanternProblem(BiharmonicProblem):
         n[:, 2] = np.where(z < 0.5, -1.0, 1.0)
         return n
 
-    def meshes(self, n_levels, regime="m~n", perturbation=1.0, seed=0, base=2):
+    def meshes(self, n_levels, regime="m~n", perturbation=1.0, seed=0, base=2, mode="cube"):
         """[(V_k, F_k)] from :func:`lantern_sequence`."""
-        return [(V, F) for V, F, _, _ in lantern_sequence(regime, n_levels, perturbation, seed, base)]
+        return [(V, F) for V, F, _, _ in lantern_sequence(regime, n_levels, perturbation, seed, base, mode)]
 
 
 class DiskPlateProblem(BiharmonicProblem):
@@ -515,7 +532,8 @@ def biharmonic_errors(V, F, u1, u2, problem):
     Returns
     -------
     dict with ``h`` (longest edge), ``n_vertices``, ``u1_L2``, ``u1_H1``,
-    ``u1_H1_grad``, ``u2_L2``, ``u1_L2_rel`` (``‖e‖ / ‖I_h u‖``), ``u2_L2_rel``.
+    ``u1_H1_grad``, ``u2_L2``, ``u2_H1`` (``|u2 - I_h u2|_H1``, no convergence expected:
+    Stein et al. 2022 §6.1), ``u1_L2_rel`` (``‖e‖ / ‖I_h u‖``), ``u2_L2_rel``.
     """
     from ..mesh import as_mesh
     mesh = as_mesh(V, F)
@@ -545,6 +563,7 @@ def biharmonic_errors(V, F, u1, u2, problem):
         "u1_H1": nrm(K, e1),
         "u1_H1_grad": float(np.sqrt(np.sum(mesh.face_areas * d2))),
         "u2_L2": nrm(M, e2),
+        "u2_H1": nrm(K, e2),
         "u1_L2_rel": nrm(M, e1) / max(nrm(M, U), 1e-300),
         "u2_L2_rel": nrm(M, e2) / max(nrm(M, U2), 1e-300),
     }

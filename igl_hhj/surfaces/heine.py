@@ -18,7 +18,7 @@ import numpy as np
 
 from .exact import Ellipsoid, ImplicitSurface, Sphere
 
-__all__ = ["HeineA", "HeineB", "heine_surfaces", "heine_coarse", "heine_sequence"]
+__all__ = ["HeineA", "HeineB", "heine_surfaces", "heine_coarse", "heine_sequence", "heine_adaptive_sequence"]
 
 
 class HeineA(ImplicitSurface):
@@ -158,3 +158,140 @@ def heine_sequence(label, n_levels, pre_refine=1, subdivisions=1, amount=0.25, j
             Vk = surface.project(Vk * surface.axes)
         out.append((Vk, np.asarray(Fk, dtype=np.int64)))
     return out, surface
+
+
+# ------------------------------------------------------------ Heine's mesh family (§5)
+def _to_surface(label, surface, P):
+    """Unit-sphere points onto the Heine surface (as :func:`heine_sequence`)."""
+    if label == "5.1a":
+        return HeineA.from_sphere(P)
+    if label == "5.1b":
+        return HeineB.from_sphere(P)
+    if label == "5.1c":
+        return surface.project(P * surface.axes)
+    return P
+
+
+def _bisect(P, F, marked_edges_of):
+    """Newest-vertex bisection with closure on the unit sphere.
+
+    ``F`` (#F, 3): corner 0 is the newest vertex, the refinement edge is (F[:,1], F[:,2]).
+    ``marked_edges_of(F)`` → (#F,) bool: faces that must be bisected once.  Neighbours are
+    bisected as needed until the mesh is conforming (closure).  A face [a, b, c] with
+    midpoint m of bc becomes [m, a, b] and [m, c, a] (orientation kept, refinement edges
+    ab and ca).  New vertices are edge midpoints pushed back onto the unit sphere.
+
+    Returns
+    -------
+    P : (#V', 3), F : (#F', 3) int64
+    """
+    P = np.asarray(P, dtype=np.float64)
+    F = np.asarray(F, dtype=np.int64)
+    want = marked_edges_of(F)
+    # edges to split: refinement edges of wanted faces, closed under "a split edge of a face
+    # forces the split of that face's refinement edge"
+    key = lambda a, b: np.minimum(a, b) * (1 << 32) + np.maximum(a, b)   # noqa: E731
+    split = np.unique(key(F[want, 1], F[want, 2]))
+    while True:                                   # closure: a face holding a split edge splits its own
+        E = np.stack([key(F[:, 1], F[:, 2]), key(F[:, 2], F[:, 0]), key(F[:, 0], F[:, 1])], 1)
+        hit = np.isin(E, split)
+        need = hit.any(1) & ~hit[:, 0]
+        if not need.any():
+            break
+        split = np.union1d(split, E[need, 0])
+    mid_keys = np.zeros(0, dtype=np.int64)        # sorted edge keys → midpoint vertex ids
+    mid_ids = np.zeros(0, dtype=np.int64)
+    while True:                                   # bisect until no face holds a split edge
+        E0 = key(F[:, 1], F[:, 2])
+        todo = np.isin(E0, split)
+        if not todo.any():
+            break
+        a, b, c = F[todo, 0], F[todo, 1], F[todo, 2]
+        uk, first, inv = np.unique(E0[todo], return_index=True, return_inverse=True)
+        ids = np.full(len(uk), -1, dtype=np.int64)
+        if len(mid_keys):
+            pos = np.minimum(np.searchsorted(mid_keys, uk), len(mid_keys) - 1)
+            known = mid_keys[pos] == uk
+            ids[known] = mid_ids[pos[known]]
+        new = ids < 0
+        if new.any():
+            M = 0.5 * (P[b[first[new]]] + P[c[first[new]]])
+            M /= np.linalg.norm(M, axis=1, keepdims=True)
+            ids[new] = len(P) + np.arange(new.sum())
+            P = np.concatenate([P, M])
+            order = np.argsort(np.concatenate([mid_keys, uk[new]]))
+            mid_keys = np.concatenate([mid_keys, uk[new]])[order]
+            mid_ids = np.concatenate([mid_ids, ids[new]])[order]
+        m = ids[inv]
+        # a split edge stays in ``split``: a face on its other side still holds it (as its
+        # refinement edge once its own refinement edge is split) and reuses the midpoint
+        F = np.concatenate([F[~todo], np.stack([m, a, b], 1), np.stack([m, c, a], 1)])
+    return P, F
+
+
+def heine_adaptive_sequence(label, n_levels, degree=2, tolerance=0.005, max_adaptive=40,
+                            theta=0.5):
+    """Heine's mesh family (§5): adaptive refinement of the icosahedron until the L2 distance
+    of the degree-γ surface to the exact one is below ``tolerance`` (0.005 in the paper),
+    then ``n_levels - 1`` global refinements "by doubly bisecting the elements".
+
+    Refinement is newest-vertex bisection with closure (:func:`_bisect`, as ALBERT's) built on
+    the unit sphere and mapped onto the surface as :func:`heine_sequence`; the adaptive
+    steps mark the faces carrying the largest local errors ``∫_T dist(x, Γ)²`` until they hold
+    the fraction ``theta`` of the total (Dörfler marking).  The geometric error is measured on
+    the degree-``degree`` nodal interpolant (:class:`igl_hhj.curved.LagrangeSurface`); while
+    that interpolant folds (too coarse a mesh for the surface), every face is bisected.
+
+    Returns
+    -------
+    levels : list of (V, F), surface, info : dict (``adaptive_steps``, ``geometric_error`` per level)
+    """
+    from ..curved import LagrangeSurface
+    from .meshing import icosphere
+    surfaces = heine_surfaces()
+    if label not in surfaces:
+        raise ValueError(f"unknown Heine surface {label!r}; use one of {sorted(surfaces)}")
+    if not (isinstance(n_levels, (int, np.integer)) and n_levels >= 1):
+        raise ValueError(f"n_levels must be an integer >= 1, got {n_levels!r}")
+    if not tolerance > 0:
+        raise ValueError(f"tolerance must be > 0, got {tolerance!r}")
+    surface = surfaces[label]
+    P, F = icosphere(0)
+    P = P / np.linalg.norm(P, axis=1, keepdims=True)
+    F = np.asarray(F, dtype=np.int64)
+    # initial refinement edge: the longest edge of each face, moved opposite corner 0
+    L = np.stack([np.linalg.norm(P[F[:, (i + 1) % 3]] - P[F[:, (i + 2) % 3]], axis=1) for i in range(3)], 1)
+    r = np.argmax(L + 1e-9 * np.arange(3), axis=1)
+    F = np.stack([F[np.arange(len(F)), (r + j) % 3] for j in range(3)], 1)
+
+    def geometric(P, F):
+        V = _to_surface(label, surface, P)
+        try:
+            surf = LagrangeSurface.from_projection(V, F, degree, surface.project, interpolant="nodal")
+        except ValueError:                        # too coarse: a curved element folds; refine all
+            return np.inf, np.ones(len(F))
+        faces, bary, w = surf.quadrature()
+        X = surf.points(faces, bary)
+        d2 = ((X - surface.project(X)) ** 2).sum(1)
+        local = np.bincount(faces, weights=w * d2, minlength=len(F))
+        return float(np.sqrt(local.sum())), local
+
+    info = {"adaptive_steps": 0, "geometric_error": []}
+    err, local = geometric(P, F)
+    while err > tolerance and info["adaptive_steps"] < max_adaptive:
+        order = np.argsort(local)[::-1]
+        k = int(np.searchsorted(np.cumsum(local[order]), theta * local.sum())) + 1
+        mark = np.zeros(len(F), dtype=bool)
+        mark[order[:k]] = True
+        P, F = _bisect(P, F, lambda G, m=mark, n=len(F): np.pad(m, (0, len(G) - n)))
+        info["adaptive_steps"] += 1
+        err, local = geometric(P, F)
+    out = []
+    for lev in range(n_levels):
+        if lev:
+            for _ in range(2):                    # "doubly bisecting the elements"
+                P, F = _bisect(P, F, lambda G: np.ones(len(G), dtype=bool))
+            err, _ = geometric(P, F)
+        info["geometric_error"].append(err)
+        out.append((_to_surface(label, surface, P), F.copy()))
+    return out, surface, info
