@@ -47,6 +47,7 @@ lines stay readable on graded meshes.
 """
 from __future__ import annotations
 
+import gc
 import os
 from dataclasses import dataclass, field
 from typing import Any
@@ -549,13 +550,46 @@ def _add_scalars(reg):
         _add_scalar(reg, sname, qname, q)
 
 
+_RETURN_CONVERSION_ERROR = "Unable to convert function return value"
+_SINGULAR = {"vertices": "vertex", "faces": "face", "nodes": "node", "edges": "edge"}
+
+
+def _set(method, *args):
+    """Call a polyscope quantity setter for its effect.  polyscope 2.6's bindings return
+    the quantity itself from setters such as ``set_color_map``; in some processes (about
+    one run in four of ``tests/test_view.py`` after other tests) nanobind fails to
+    convert that returned ``SurfaceScalarQuantity`` reference ("Unable to convert
+    function return value ..."), after the C++ setter has run.  That error is ignored:
+    the setting is made, only the unused return value is lost; any other error is
+    raised."""
+    try:
+        method(*args)
+    except TypeError as exc:
+        if _RETURN_CONVERSION_ERROR not in str(exc):
+            raise
+
+
 def _add_scalar(reg, sname, qname, q, colour_bar=False):
     """Hand one recorded scalar quantity to polyscope (``colour_bar``: with polyscope's
-    own on-screen colour bar, drawn in screenshots that include the UI)."""
-    reg.structures[sname].add_scalar_quantity(
-        qname, np.nan_to_num(q.values, nan=0.0, posinf=0.0, neginf=0.0), defined_on=q.defined_on,
-        vminmax=q.vminmax, cmap=q.cmap, enabled=q.enabled,
-        **({"onscreen_colorbar_enabled": True} if colour_bar else {}))
+    own on-screen colour bar, drawn in screenshots that include the UI).
+
+    The quantity is added through polyscope's bound structure and configured with
+    :func:`_set` (what ``add_scalar_quantity(..., vminmax=, cmap=, enabled=)`` does, without
+    its failing return-value conversion)."""
+    import polyscope_bindings as psb
+    values = np.nan_to_num(np.asarray(q.values, dtype=np.float64), nan=0.0, posinf=0.0, neginf=0.0)
+    bound = reg.structures[sname].bound_instance
+    # vertices, faces (surface meshes), nodes, edges (curve networks)
+    add = getattr(bound, f"add_{_SINGULAR[q.defined_on]}_scalar_quantity")
+    bq = add(qname, values, psb.DataType.standard)
+    if q.vminmax is not None:
+        _set(bq.set_map_range, tuple(float(v) for v in q.vminmax))
+    if q.cmap is not None:
+        _set(bq.set_color_map, q.cmap)
+    if colour_bar:
+        _set(bq.set_onscreen_colorbar_enabled, True)
+    if q.enabled is not None:
+        _set(bq.set_enabled, bool(q.enabled))
 
 
 def _line_field(reg, sname, qname, vectors, normals, defined_on, enabled=False):
