@@ -27,7 +27,7 @@ __all__ = [
     "face_principal_curvature", "face_mean_curvature", "face_gaussian_curvature",
     "principal_from_shape_operator", "vertex_shape_operator", "vertex_principal_curvature",
     "check_principal_curvature_args", "boundary_treatment", "smoothed_face_shape_operator",
-    "dropin_vertex_values", "curvature_of", "CURVATURE_KINDS", "CURVATURE_KIND_ALIASES", "CURVATURE_PER",
+    "dropin_vertex_values", "dropin_on_mesh", "curvature_of", "CURVATURE_KINDS", "CURVATURE_KIND_ALIASES", "CURVATURE_PER",
 ]
 
 
@@ -378,9 +378,7 @@ def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary: str = "estim
         from .repair import repaired_shape_operator
         kw = dict(boundary=boundary, boundary_normals=boundary_normals,
                   boundary_shape_operator=boundary_shape_operator, simply_supported=simply_supported,
-                  solver=solver, rtol=rtol)
-        if feature_angle is not None:
-            kw["feature_angle"] = feature_angle
+                  solver=solver, rtol=rtol, feature_angle=feature_angle)
         return repaired_shape_operator(shape_operator, exc, V, F, kw)
     if feature_angle is not None:
         from .features import _prepare
@@ -776,15 +774,22 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
         from .repair import repaired_principal_curvature
         kw = dict(boundary=boundary, boundary_normals=boundary_normals,
                   boundary_shape_operator=boundary_shape_operator, simply_supported=simply_supported,
-                  solver=solver, rtol=rtol)
-        if feature_angle is not None:
-            kw["feature_angle"] = feature_angle
+                  solver=solver, rtol=rtol, feature_angle=feature_angle)
         return repaired_principal_curvature(principal_curvature, exc, V, F, radius, useKring, kw)
     if feature_angle is not None:
         from .features import _feature_dropin
         return _feature_dropin(mesh, None, radius, feature_angle=feature_angle, boundary=boundary,
                               solver=solver, rtol=rtol,
                               data=(boundary_normals, boundary_shape_operator, simply_supported))
+    return dropin_on_mesh(mesh, radius, boundary, boundary_normals, boundary_shape_operator,
+                          simply_supported, solver, rtol)
+
+
+def dropin_on_mesh(mesh, radius, boundary, boundary_normals, boundary_shape_operator, simply_supported,
+                   solver, rtol):
+    """:func:`principal_curvature` on a validated :class:`~igl_hhj.mesh.TriangleMesh` (also
+    the cut mesh of :mod:`igl_hhj.features`): the boundary treatment, S_h
+    (:func:`_shape_operator`), then :func:`dropin_vertex_values`."""
     boundary_normals, treatment = _resolve_boundary(mesh, boundary, boundary_normals,
                                                     boundary_shape_operator)
     rtol = _check_rtol(rtol)

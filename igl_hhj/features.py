@@ -425,12 +425,8 @@ def _side_values(V, F, radius, feature_angle, crease_edges, boundary, solver, rt
     from .solvers import DEFAULT_RTOL
     curvature.check_principal_curvature_args(radius, True)
     mesh, ct, cut, cm = _prepare(V, F, feature_angle, crease_edges, boundary, data)
-    rtol = curvature._check_rtol(DEFAULT_RTOL if rtol is None else rtol)
-    bn, treatment = curvature._resolve_boundary(cm, "estimate", None, None)
-    S = curvature._shape_operator(cm, bn, None, None, solver, rtol, estimated=treatment == "estimate")
-    holder = [S]
-    del S
-    return mesh, ct, cut, cm, curvature.dropin_vertex_values(cm, holder, radius, rtol)
+    return mesh, ct, cut, cm, curvature.dropin_on_mesh(cm, radius, "estimate", None, None, None, solver,
+                                                       DEFAULT_RTOL if rtol is None else rtol)
 
 
 def _feature_dropin(V: Any, F: ArrayLike | None, radius: int, *, feature_angle: float | None,
