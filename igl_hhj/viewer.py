@@ -47,7 +47,6 @@ lines stay readable on graded meshes.
 """
 from __future__ import annotations
 
-import gc
 import os
 from dataclasses import dataclass, field
 from typing import Any
@@ -489,27 +488,39 @@ def _rotation_for(view, V, F):
 
 
 # --------------------------------------------------------------------------- registration helpers
-def _surface(ps, reg, name, V, F, offset=None, view=None, title=None):
-    """Register a surface mesh under ``name`` (turned by ``view``, translated by ``offset``),
-    replacing one of the same name; ``title`` is drawn above it in screenshots."""
+def _placed(reg, name, V, F, offset=None, view=None):
+    """The displayed positions of the mesh (V, F) registered as ``name``: turned by ``view``
+    (the rotation recorded in ``reg.rotations``) and translated by ``offset``."""
     R = _rotation_for(view, V, F)
     if R is not None:
         V = V @ R.T
         reg.rotations[name] = R
-    if title:
-        reg.titles[name] = str(title)
     if offset is not None:
         off = np.asarray(offset, dtype=np.float64)
         if off.shape != (3,) or not np.all(np.isfinite(off)):
             raise ValueError(f"offset must be 3 finite numbers, got {offset!r}")
         V = V + off
+    return V
+
+
+def _record_bounds(reg, name, X):
+    """Add the bounding box of a structure's displayed points X to ``reg`` and the registry."""
+    box = np.stack([X.min(axis=0), X.max(axis=0)])
+    reg.bounds = _union_bounds(reg.bounds, box)
+    _REGISTERED[name] = box
+
+
+def _surface(ps, reg, name, V, F, offset=None, view=None, title=None):
+    """Register a surface mesh under ``name`` (turned by ``view``, translated by ``offset``),
+    replacing one of the same name; ``title`` is drawn above it in screenshots."""
+    V = _placed(reg, name, V, F, offset, view)
+    if title:
+        reg.titles[name] = str(title)
     if ps.has_surface_mesh(name):
         ps.remove_surface_mesh(name)
     s = ps.register_surface_mesh(name, V, F, color=(0.75, 0.75, 0.75))  # grey: no quantity shown
     reg.structures[name] = s
-    box = np.stack([V.min(axis=0), V.max(axis=0)])
-    reg.bounds = _union_bounds(reg.bounds, box)
-    _REGISTERED[name] = box
+    _record_bounds(reg, name, V)
     return s
 
 
@@ -1151,25 +1162,14 @@ def register_creases(V: Any, F: Any = None, creases=None, *, feature_angle=40.0,
         raise ValueError("no crease edges to draw (lower feature_angle)")
     ps = _polyscope_for(screenshot)
     reg = Registration()
-    X = mesh.V
-    R = _rotation_for(view, mesh.V, mesh.F)
-    if R is not None:
-        X = X @ R.T
-        reg.rotations[name] = R
-    if offset is not None:
-        off = np.asarray(offset, dtype=np.float64)
-        if off.shape != (3,) or not np.all(np.isfinite(off)):
-            raise ValueError(f"offset must be 3 finite numbers, got {offset!r}")
-        X = X + off
+    X = _placed(reg, name, mesh.V, mesh.F, offset, view)
     used = np.unique(creases.edges)                       # only the crease vertices as nodes
     nodes = X[used]
     edges = np.searchsorted(used, creases.edges)
     if ps.has_curve_network(name):
         ps.remove_curve_network(name)
     reg.structures[name] = ps.register_curve_network(name, nodes, edges, radius=radius, color=(0.1, 0.1, 0.1))
-    box = np.stack([nodes.min(axis=0), nodes.max(axis=0)])
-    reg.bounds = box
-    _REGISTERED[name] = box
+    _record_bounds(reg, name, nodes)
     deg = np.degrees(creases.theta)
     rng = _explicit_range(vminmax) if vminmax is not None else color_range(deg, symmetric=True)
     reg.ranges["crease angle"] = rng
