@@ -96,6 +96,12 @@ _PLY_SIZES = {"char": 1, "int8": 1, "uchar": 1, "uint8": 1, "short": 2, "int16":
               "float": 4, "float32": 4, "double": 8, "float64": 8}
 
 
+def _ply_scalar(order, t):
+    """The numpy dtype string of PLY scalar type ``t`` in byte order ``order`` ("<" or ">")."""
+    kind = "f" if t in ("float", "float32", "double", "float64") else ("u" if t.startswith("u") else "i")
+    return order + kind + str(_PLY_SIZES[t])
+
+
 class MeshFileError(ValueError):
     """A mesh or output file the command line cannot use (message: one line)."""
 
@@ -897,10 +903,8 @@ def _read_polygon_ply(path, head, sizes):
     if fmt == "ascii":
         with open(path, "rb") as fh:
             n_head = fh.read(body_start).count(b"\n")
+            body = fh.read()                                     # the rest: the body
         L = _Lines(path, body_start, comments=False, first_line=n_head + 1)
-        with open(path, "rb") as fh:
-            fh.seek(body_start)
-            body = fh.read()
         cut = int(L.offset[nV] - body_start) if len(L) > nV else len(body)
         V = np.fromstring(body[:cut], sep=" ").reshape(nV, len(vprops))[:, xyz]
         end = int(L.offset[nV + len(sizes)] - body_start) if len(L) > nV + len(sizes) else len(body)
@@ -913,9 +917,7 @@ def _read_polygon_ply(path, head, sizes):
     else:
         order = "<" if fmt == "binary_little_endian" else ">"
         kinds = {1: "i1", 2: "i2", 4: "i4", 8: "i8"}
-        vdt = np.dtype([(p, order + ("f" if t[0] in ("float", "float32", "double", "float64") else
-                                      ("u" if t[0].startswith("u") else "i")) + str(_PLY_SIZES[t[0]]))
-                        for p, t in elements[0][2]])
+        vdt = np.dtype([(p, _ply_scalar(order, t[0])) for p, t in elements[0][2]])
         vert = np.fromfile(path, dtype=vdt, count=nV, offset=body_start)
         V = np.column_stack([vert[c].astype(np.float64) for c in "xyz"])
         k = int(sizes[0])
@@ -1218,8 +1220,7 @@ def _ply_values(path):
     order = {"ascii": "<", "binary_little_endian": "<", "binary_big_endian": ">"}[fmt]
 
     def scalar(t):
-        kind = "f" if t in ("float", "float32", "double", "float64") else ("u" if t.startswith("u") else "i")
-        return order + kind + str(_PLY_SIZES[t])
+        return _ply_scalar(order, t)
 
     dtypes = []
     for name, n, props in elements:
