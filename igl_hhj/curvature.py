@@ -198,17 +198,19 @@ def _boundary_rhs(mesh, rhs, clamped, N):
 
 
 def _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver,
-                    rtol=DEFAULT_RTOL, info=None, estimated=False):
+                    rtol=DEFAULT_RTOL, info=None, estimated=False, groups_of=None):
     """Compiled path of :func:`shape_operator` (reference: :func:`_shape_operator_reference`).
 
     A mesh with several connected components is solved in independent groups
     (:func:`igl_hhj.components.solve_groups`): no component depends on another.
     ``estimated``: ``boundary_normals`` come from :func:`estimate_boundary_normals`
-    (see :func:`_boundary_partition`)."""
+    (see :func:`_boundary_partition`).  ``groups_of``: a mesh with the same faces
+    whose components define the groups instead (the caller's mesh for its cut along
+    the creases, :mod:`igl_hhj.features`: the sides of one part are one solve)."""
     data = (boundary_normals, boundary_shape_operator, simply_supported)
     groups = None
     if all(d is None or np.shape(d)[:1] == (mesh.n_vertices,) for d in data):
-        groups = _components.solve_groups(mesh, solver)
+        groups = _components.solve_groups(mesh if groups_of is None else groups_of, solver)
     if groups is None:
         return _shape_operator_one(mesh, *data, solver, rtol, info, estimated)
     if len(groups) == 1:              # every component small: one direct solve of the mesh
@@ -380,14 +382,24 @@ def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary: str = "estim
                   boundary_shape_operator=boundary_shape_operator, simply_supported=simply_supported,
                   solver=solver, rtol=rtol, feature_angle=feature_angle)
         return repaired_shape_operator(shape_operator, exc, V, F, kw)
+    groups_of = None
     if feature_angle is not None:
         from .features import _prepare
-        _, _, _, mesh = _prepare(mesh, None, feature_angle, None, boundary,
-                                 (boundary_normals, boundary_shape_operator, simply_supported))
+        groups_of, _, _, mesh = _prepare(mesh, None, feature_angle, None, boundary,
+                                         (boundary_normals, boundary_shape_operator, simply_supported))
+    return _checked_shape_operator(mesh, boundary, boundary_normals, boundary_shape_operator,
+                                   simply_supported, solver, rtol, groups_of)
+
+
+def _checked_shape_operator(mesh, boundary, boundary_normals, boundary_shape_operator, simply_supported,
+                            solver, rtol, groups_of=None):
+    """:func:`shape_operator` on a validated mesh (also the cut mesh of
+    :func:`igl_hhj.features.feature_shape_operator`, ``groups_of`` the uncut mesh): the
+    boundary treatment, :func:`_shape_operator`, and no silent NaN."""
     boundary_normals, treatment = _resolve_boundary(mesh, boundary, boundary_normals,
                                                     boundary_shape_operator)
     S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver,
-                        _check_rtol(rtol), estimated=treatment == "estimate")
+                        _check_rtol(rtol), estimated=treatment == "estimate", groups_of=groups_of)
     bad = ~np.isfinite(S).all(axis=(1, 2))
     if bad.any():                     # never silent NaN (issue 12)
         from .errors import SolverError
@@ -786,15 +798,16 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
 
 
 def dropin_on_mesh(mesh, radius, boundary, boundary_normals, boundary_shape_operator, simply_supported,
-                   solver, rtol):
+                   solver, rtol, groups_of=None):
     """:func:`principal_curvature` on a validated :class:`~igl_hhj.mesh.TriangleMesh` (also
-    the cut mesh of :mod:`igl_hhj.features`): the boundary treatment, S_h
-    (:func:`_shape_operator`), then :func:`dropin_vertex_values`."""
+    the cut mesh of :mod:`igl_hhj.features`, with ``groups_of`` the uncut mesh, see
+    :func:`_shape_operator`): the boundary treatment, S_h (:func:`_shape_operator`), then
+    :func:`dropin_vertex_values`."""
     boundary_normals, treatment = _resolve_boundary(mesh, boundary, boundary_normals,
                                                     boundary_shape_operator)
     rtol = _check_rtol(rtol)
     S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver,
-                        rtol, estimated=treatment == "estimate")
+                        rtol, estimated=treatment == "estimate", groups_of=groups_of)
     holder = [S]     # the only reference: the vertex stage frees S before smoothing
     del S
     return dropin_vertex_values(mesh, holder, radius, rtol)

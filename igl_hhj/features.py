@@ -280,14 +280,13 @@ def cut_along(mesh: TriangleMesh, crease: NDArray[np.bool_]) -> CutMesh:
 
 
 def _cut_mesh(mesh, crease):
-    """The TriangleMesh of the cut (no unwelded-seam warning: the seams are the creases)."""
-    import warnings
-    from .mesh import MeshWarning
+    """The TriangleMesh of the cut, without a second validation: the cut of a valid mesh
+    is a valid mesh (the same faces and positions, so no new degenerate face; cutting
+    along edges keeps it edge-manifold and oriented; each side is one fan), and the
+    seams are the creases (no unwelded-seam warning).  The per-face metrics of ``mesh``
+    are reused (:meth:`igl_hhj.mesh.TriangleMesh._same_faces`)."""
     cut = cut_along(mesh, crease)
-    with warnings.catch_warnings():
-        warnings.filterwarnings("ignore", message=".*boundary vertices coincide", category=MeshWarning)
-        cm = TriangleMesh(cut.V, cut.F)
-    return cut, cm
+    return cut, TriangleMesh._same_faces(mesh, cut.V, cut.F)
 
 
 def _prepare(V, F, feature_angle, crease_edges_, boundary, data):
@@ -324,7 +323,8 @@ def feature_shape_operator(V: Any, F: ArrayLike | None = None, *,
     from . import curvature
     from .solvers import DEFAULT_RTOL
     mesh, crease, cut, cm = _prepare(V, F, feature_angle, crease_edges, "estimate", ())
-    return curvature.shape_operator(cm, None, solver=solver, rtol=DEFAULT_RTOL if rtol is None else rtol)
+    return curvature._checked_shape_operator(cm, "estimate", None, None, None, solver,
+                                             DEFAULT_RTOL if rtol is None else rtol, groups_of=mesh)
 
 
 @dataclass(frozen=True)
@@ -426,7 +426,8 @@ def _side_values(V, F, radius, feature_angle, crease_edges, boundary, solver, rt
     curvature.check_principal_curvature_args(radius, True)
     mesh, ct, cut, cm = _prepare(V, F, feature_angle, crease_edges, boundary, data)
     return mesh, ct, cut, cm, curvature.dropin_on_mesh(cm, radius, "estimate", None, None, None, solver,
-                                                       DEFAULT_RTOL if rtol is None else rtol)
+                                                       DEFAULT_RTOL if rtol is None else rtol,
+                                                       groups_of=mesh)
 
 
 def _feature_dropin(V: Any, F: ArrayLike | None, radius: int, *, feature_angle: float | None,

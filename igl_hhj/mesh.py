@@ -248,6 +248,25 @@ class TriangleMesh:
         # the (#F, 3, 3) edge vectors are recomputed on demand (memory: 72 B/face)
         self.__dict__.pop("_edge_vectors", None)
 
+    @classmethod
+    def _same_faces(cls, mesh, V, F):
+        """A mesh of the faces of ``mesh`` with new vertex indices ``F`` into ``V``, built
+        without the checks (internal: the caller guarantees that every row of ``F`` has the
+        positions of the same row of ``mesh.F`` and that the result is an oriented
+        edge-manifold mesh, as :func:`igl_hhj.features.cut_along` does).  The per-face
+        metrics of ``mesh`` are reused: they depend only on the corner positions."""
+        self = cls.__new__(cls)
+        self.V = np.array(V, dtype=np.float64, order="C")
+        self.F = np.array(F, dtype=np.int64, order="C")
+        if self.F.shape != mesh.F.shape:
+            raise ValueError(f"_same_faces: F must have the shape {mesh.F.shape}, got {self.F.shape}")
+        self.V.setflags(write=False)
+        self.F.setflags(write=False)
+        for key in ("_cross", "face_double_areas", "face_areas", "face_normals", "edge_lengths"):
+            if key in mesh.__dict__:
+                self.__dict__[key] = mesh.__dict__[key]
+        return self
+
     # ------------------------------------------------------------------ sizes
     @property
     def n_vertices(self):
