@@ -72,10 +72,14 @@ def crease_study(request):
         _, _, PV1, PV2, _ = igl_hhj.principal_curvature(V, F)
         Hex = side_exact_H(s, on.cut, mesh.face_normals)
         band = ring_distance(mesh, np.unique(on.creases.edges), 2) <= 2
-        err_on = np.abs(on.side_mean_curvature - Hex)[band[on.side_parent]].max()
-        err_off = np.abs(0.5 * (PV1 + PV2) - Hex[:len(V)])[band].max()
+        e_on = np.abs(on.side_mean_curvature - Hex)
+        e_off = np.abs(0.5 * (PV1 + PV2) - Hex[:len(V)])
+        err_on = e_on[band[on.side_parent]].max()
+        err_off = e_off[band].max()
+        far = ~band                                         # the smooth parts: > 2 rings from a rim
         rows.append((mesh.edge_lengths.max(), err_on, err_off, on.creases.total_angle_length,
-                     on.creases.n_chains, len(on.creases.corners), np.abs(Hex).max()))
+                     on.creases.n_chains, len(on.creases.corners), np.abs(Hex).max(),
+                     np.sqrt(np.mean(e_on[:len(V)][far] ** 2)), np.sqrt(np.mean(e_off[far] ** 2))))
     return request.param, s, np.array(rows)
 
 
@@ -88,6 +92,18 @@ def test_band_converges_with_features_and_not_without(crease_study):
     # without features the rim's Dirac measure is smeared into the band: no convergence
     assert (r_off <= 0).all(), f"{name}, features off, band EOCs {np.round(r_off, 3)} (errors {off})"
     assert off[-1] > Hmax, f"{name}, features off, finest band error {off[-1]:.3g}"
+
+
+def test_smooth_parts_converge_with_features_and_not_without(crease_study):
+    """Issue 27's "smooth parts stay smooth", on the exact surfaces: the RMS vertex H error
+    farther than 2 rings from a rim converges with features; without, the rim's curvature
+    carried by the smoothing (up to 25 rings) makes it grow."""
+    name, s, rows = crease_study
+    hs, on, off = rows[:, 0], rows[:, 7], rows[:, 8]
+    r_on, r_off = eoc(on, hs), eoc(off, hs)
+    assert (r_on >= 0.9).all(), f"{name}, features on, RMS EOCs beyond 2 rings {np.round(r_on, 3)} ({on})"
+    assert (r_off <= 0).all(), f"{name}, features off, RMS EOCs beyond 2 rings {np.round(r_off, 3)} ({off})"
+    assert on[-1] < 0.01 * off[-1], f"{name}: finest RMS beyond 2 rings {on[-1]:.3g} on, {off[-1]:.3g} off"
 
 
 def test_crease_line_measure_converges(crease_study):
@@ -322,3 +338,68 @@ def test_cli_screenshot_draws_the_creases(tmp_path):
         im = mpimg.imread(str(p))[..., :3]
         bars[tag] = float((im[-40:].min(axis=2) < 0.9).mean())
     assert bars["on"] > 1.3 * bars["off"], bars             # a second bar: crease angle θ
+
+
+def test_cut_mesh_is_the_validated_cut():
+    """The cut mesh is built without a second validation (TriangleMesh._same_faces): its
+    topology, face metrics and normals are those of the validated mesh of the same arrays."""
+    V, F, _ = capped_cylinder(1)
+    mesh = as_mesh(V, F)
+    mesh.face_normals                                       # cached: passed on to the cut
+    cut, cm = ft._cut_mesh(mesh, ft.crease_edges(mesh))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")                     # the seams coincide: that is the cut
+        ref = as_mesh(cut.V, cut.F)
+    for name in ("edges", "face_edges", "edge_faces", "edge_local_index", "edge_face_count",
+                 "boundary_edges", "face_double_areas", "face_normals", "edge_lengths", "vertex_normals"):
+        np.testing.assert_array_equal(getattr(cm, name), getattr(ref, name), err_msg=name)
+    assert not cm.V.flags.writeable and not cm.F.flags.writeable
+    with pytest.raises(ValueError, match="_same_faces"):
+        type(mesh)._same_faces(mesh, cut.V, cut.F[:-1])
+
+
+def _count_calls(monkeypatch, cls, name):
+    calls = []
+    orig = getattr(cls, name)
+
+    def counted(self, *a, **k):
+        calls.append(self)
+        return orig(self, *a, **k)
+    monkeypatch.setattr(cls, name, counted)
+    return calls
+
+
+def test_cut_mesh_costs_one_solve_and_one_validation(monkeypatch):
+    """Cost without timing: on a connected mesh the sides of the cut are one HHJ system
+    (the groups of the caller's mesh, not of the cut: fandisk's 12 sides were 4 solves, 3
+    by PCG and the small sides together by LDLᵀ), and only the caller's mesh is validated."""
+    from igl_hhj.mesh import TriangleMesh
+    from igl_hhj.solvers import HHJSystem
+    V, F, mesh = _fandisk()
+    _, cm = ft._cut_mesh(mesh, ft.crease_edges(mesh))
+    from igl_hhj import kernels
+    assert kernels.vertex_components(cm)[1] == 12           # 12 sides ...
+    systems = _count_calls(monkeypatch, HHJSystem, "__init__")
+    checks = _count_calls(monkeypatch, TriangleMesh, "_check_manifold_and_orientation")
+    igl_hhj.principal_curvature(V, F, feature_angle=40)
+    assert len(systems) == 1 and systems[0].mesh.n_faces == len(F)   # ... one solve
+    assert len(checks) == 1                                  # the caller's mesh only
+    igl_hhj.shape_operator(V, F, feature_angle=40)
+    ft.feature_shape_operator(V, F)
+    assert len(systems) == 3
+
+
+def test_parts_of_the_callers_mesh_stay_independent():
+    """Two disjoint parts: each part's values with features do not depend on the other
+    (its own solve group, as without features; issue 23's locality, to the same ≤ 1e-12
+    absolute as tests/test_intrinsic.py::test_components_do_not_see_each_other)."""
+    V, F, _ = capped_cylinder(2)
+    V2 = np.vstack([V, V * 0.5 + (5.0, 0.0, 0.0)])
+    F2 = np.vstack([F, F + len(V)])
+    a = ft.feature_principal_curvature(V, F)
+    b = ft.feature_principal_curvature(V2, F2)
+    nV = len(V)
+    for x, y in ((a.side_PV1, b.side_PV1[b.side_parent < nV]), (a.side_PV2, b.side_PV2[b.side_parent < nV])):
+        assert np.abs(x - y).max() <= 1e-12
+    S = ft.feature_shape_operator(V2, F2)
+    assert np.abs(ft.feature_shape_operator(V, F) - S[:len(F)]).max() <= 1e-12
