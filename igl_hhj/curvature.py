@@ -17,6 +17,7 @@ from . import kernels
 from . import components as _components
 from . import intrinsic as _intrinsic
 from . import recovery as _recovery
+from . import small_mesh as _small_mesh
 from .boundary_estimation import BOUNDARY_TREATMENTS, estimate_boundary_normals
 from .hhj import HHJProjection, clamped_load
 from .mesh import MeshDefectError, _as_array, as_mesh, mark_bad_vertices, per_vertex_array
@@ -780,6 +781,13 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
     1.0
     """
     check_principal_curvature_args(radius, useKring)
+    if feature_angle is None and boundary_normals is None and boundary_shape_operator is None \
+            and simply_supported is None and isinstance(solver, str) and solver in ("auto", "direct") and isinstance(boundary, str) \
+            and boundary in BOUNDARY_TREATMENTS:
+        # a small clean closed mesh: the same values in one compiled call (igl_hhj.small_mesh)
+        out = _small_mesh.try_dropin(V, F, radius, _check_rtol(rtol))
+        if out is not None:
+            return out
     try:
         mesh = as_mesh(V, F)
     except MeshDefectError as exc:       # repairable defect: repair, compute, map back (issue 24)

@@ -403,7 +403,12 @@ class TriangleMesh:
         """(#E,) float64: length of each unique edge."""
         d = np.take(self.V, self.edges[:, 1], axis=0)
         d -= np.take(self.V, self.edges[:, 0], axis=0)
-        return np.sqrt(np.einsum("ea,ea->e", d, d))
+        d *= d
+        # (d0² + d1²) + d2² in this order on every machine (einsum's order depends on the
+        # SIMD width), as the compiled small-mesh path (igl_hhj.small_mesh) computes it
+        s = d[:, 0] + d[:, 1]
+        s += d[:, 2]
+        return np.sqrt(s, out=s)
 
     @cached_property
     def edge_tangents(self):

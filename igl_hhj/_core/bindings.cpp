@@ -505,4 +505,47 @@ NB_MODULE(_hhj_core, m) {
         return nb::make_tuple(to_numpy(std::move(PD1), {nn, 3}), to_numpy(std::move(PD2), {nn, 3}),
                               to_numpy(std::move(PV1), {nn}), to_numpy(std::move(PV2), {nn}));
     });
+
+    m.def("dropin_small", [](In<double> V, In<i64> F, In<double> N, In<double> cot, nb::tuple checks,
+                             nb::tuple smoothing, std::vector<double> binom) {
+        need(V.ndim() == 2 && V.shape(1) == 3 && F.ndim() == 2 && F.shape(1) == 3, "dropin_small: V, F shapes");
+        const i64 nV = V.shape(0), nF = F.shape(0);
+        need(N.ndim() == 2 && N.shape(0) == (size_t)nV && N.shape(1) == 3 && cot.ndim() == 2 &&
+             cot.shape(0) == (size_t)nF && cot.shape(1) == 3, "dropin_small: N, cot shapes");
+        need(nV > 0 && nF > 0 && nF < ((i64)1 << 24), "dropin_small: mesh size");
+        for (i64 q = 0; q < 3 * nF; ++q) need(F.data()[q] >= 0 && F.data()[q] < nV, "dropin_small: F out of range");
+        need(checks.size() == 6 && smoothing.size() == 10, "dropin_small: parameter tuples");
+        hhj::SmallParams p;
+        p.degenerate_rtol = nb::cast<double>(checks[0]);
+        p.min_mesh_size = nb::cast<double>(checks[1]);
+        p.folded_rtol = nb::cast<double>(checks[2]);
+        p.quality_floor = nb::cast<double>(checks[3]);
+        p.direct_rtol = nb::cast<double>(checks[4]);
+        p.max_edges = nb::cast<i64>(checks[5]);
+        p.radius = nb::cast<double>(smoothing[0]);
+        p.per_radius = nb::cast<double>(smoothing[1]);
+        p.pilot_radius = nb::cast<double>(smoothing[2]);
+        p.smoothing_rtol = nb::cast<double>(smoothing[3]);
+        p.gain = nb::cast<double>(smoothing[4]);
+        p.power = nb::cast<double>(smoothing[5]);
+        p.lo = nb::cast<double>(smoothing[6]);
+        p.hi = nb::cast<double>(smoothing[7]);
+        p.steps = nb::cast<int>(smoothing[8]);
+        p.maxiter = nb::cast<i64>(smoothing[9]);
+        p.binom = std::move(binom);
+        need(p.steps >= 1, "dropin_small: steps >= 1");
+        std::vector<double> PD1((size_t)nV * 3), PD2((size_t)nV * 3), PV1(nV), PV2(nV);
+        std::vector<unsigned char> bad(nV);
+        int status;
+        {
+            nb::gil_scoped_release nogil;
+            hhj::ThreadBudget tb(0);
+            status = hhj::dropin_small(V.data(), nV, F.data(), nF, N.data(), cot.data(), p, PD1.data(), PD2.data(),
+                                       PV1.data(), PV2.data(), bad.data());
+        }
+        const size_t nn = nV;
+        return nb::make_tuple(status, to_numpy(std::move(PD1), {nn, 3}), to_numpy(std::move(PD2), {nn, 3}),
+                              to_numpy(std::move(PV1), {nn}), to_numpy(std::move(PV2), {nn}),
+                              to_numpy(std::move(bad), {nn}));
+    });
 }

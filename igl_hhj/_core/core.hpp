@@ -270,6 +270,25 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
 int envelope_ldl_solve(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const double* Ax,
                        const double* R, double* X, double resid_rtol);
 
+// small_mesh.cpp: the drop-in on a small closed mesh in one call (issue 24, fixed cost).
+// The parameters are the Python constants of the general path (igl_hhj.small_mesh).
+struct SmallParams {
+    double degenerate_rtol, min_mesh_size, folded_rtol, quality_floor, direct_rtol;
+    i64 max_edges;            // the envelope solver's limit (solvers.ENVELOPE_MAX)
+    double radius, per_radius, pilot_radius, smoothing_rtol, gain, power, lo, hi;
+    int steps;
+    std::vector<double> binom;
+    i64 maxiter;
+};
+// status of dropin_small: 0 done; else the general path must run (and raise or repair)
+enum { SMALL_OK = 0, SMALL_DEFECT = 1, SMALL_OPEN = 2, SMALL_TOO_LARGE = 3, SMALL_SOLVE = 4 };
+// V (nV, 3), F (nF, 3) with indices in range; N0 (nV, 3) libigl's area-weighted vertex
+// normals, cot (nF, 3) igl.cotmatrix_entries.  Writes PD1, PD2 (nV, 3), PV1, PV2 (nV,),
+// bad (nV,) as curvature.principal_curvature.
+int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0, const double* cot,
+                 const SmallParams& p, double* PD1, double* PD2, double* PV1, double* PV2,
+                 unsigned char* bad);
+
 // Large-call heap scope (heap.cpp): raise glibc's mmap threshold while open; the last
 // exit restores glibc's 32 MiB ceiling and trims.  enter returns whether it is raised,
 // exit whether this exit restored and trimmed.
