@@ -491,7 +491,8 @@ def markdown(rows):
 
 def tiny_meshes():
     """The fixed-cost meshes of :func:`tiny_study`: ``[(name, V, F)]`` with 8-1,280 faces,
-    closed and open (a cube, the icospheres 0-3, a coarse jittered torus, an open jittered grid)."""
+    closed and open (an octahedron, a cube, the icospheres 0-3, a coarse jittered torus, two
+    open jittered grids of 18 and 128 faces)."""
     from ..surfaces import icosphere, square_grid, torus_coarse
     V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]], float)
     F = np.array([[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4], [1, 2, 6], [1, 6, 5],
@@ -499,8 +500,9 @@ def tiny_meshes():
     out = [("octahedron", *_octahedron()), ("cube", V, F)]
     out += [(f"icosphere({n})", *icosphere(n)) for n in range(4)]
     out.append(("torus 96", *torus_coarse(n_phi=8, n_t=6)))
-    P, Fg = square_grid(8, amount=0.3, seed=3)
-    out.append(("open grid", np.c_[P, 0.3 * P[:, 0] * P[:, 1]], Fg))
+    for n in (3, 8):
+        P, Fg = square_grid(n, amount=0.3, seed=3)
+        out.append((f"open grid {2 * n * n}", np.c_[P, 0.3 * P[:, 0] * P[:, 1]], Fg))
     return out
 
 
