@@ -30,6 +30,22 @@ the default without boundary data) and "plain" (Walker's plain assembly: the fac
 normal stands in for the boundary normal)."""
 
 
+FIT_RINGS = 3
+"""Default fit neighbourhood of :func:`estimate_boundary_normals` in rings."""
+
+SIDE_DOT_MIN = 0.05
+"""An estimated boundary normal must have ``N·ν_T > SIDE_DOT_MIN`` with every boundary
+face T of the vertex (else the faces' mean normal, else none)."""
+
+
+def _dot3(a, b):
+    """Row dot products of (m, 3) arrays, summed (a0 b0 + a1 b1) + a2 b2 on every machine."""
+    d = a[:, 0] * b[:, 0]
+    d += a[:, 1] * b[:, 1]
+    d += a[:, 2] * b[:, 2]
+    return d
+
+
 def _ring_pairs(mesh: TriangleMesh, verts, rings):
     """(row, col) pairs: row indexes ``verts``, col a vertex of its ``rings``-ring (itself excluded)."""
     E = mesh.edges                       # unique edges: the vertex graph without duplicates
@@ -114,7 +130,7 @@ def boundary_normal_fits_reference(mesh: TriangleMesh, verts, rings, N0):
     return np.where((ok & ok2)[:, None], N2, N0)
 
 
-def estimate_boundary_normals(mesh: TriangleMesh, rings=3, *, reference=False):
+def estimate_boundary_normals(mesh: TriangleMesh, rings=FIT_RINGS, *, reference=False):
     """O(h²) unit normals at the boundary vertices from local quadric fits.
 
     Parameters
@@ -171,7 +187,7 @@ def estimate_boundary_normals(mesh: TriangleMesh, rings=3, *, reference=False):
     # every boundary face must see its vertices' normals on its own side
     for col_ in (0, 1):
         v = e[be, col_]
-        bad = ~(np.einsum("ma,ma->m", out[v], fn) > 0.05)
+        bad = ~(_dot3(out[v], fn) > SIDE_DOT_MIN)
         if bad.any():
             vb = np.unique(v[bad])
             pos = np.searchsorted(verts, vb)
@@ -180,5 +196,5 @@ def estimate_boundary_normals(mesh: TriangleMesh, rings=3, *, reference=False):
     # opposite wings, a folded sheet): no normal, the caller keeps those edges plain
     for col_ in (0, 1):
         v = e[be, col_]
-        out[np.unique(v[~(np.einsum("ma,ma->m", out[v], fn) > 0.05)])] = np.nan
+        out[np.unique(v[~(_dot3(out[v], fn) > SIDE_DOT_MIN)])] = np.nan
     return out

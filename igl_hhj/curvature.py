@@ -785,7 +785,7 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
             and simply_supported is None and isinstance(solver, str) and solver in ("auto", "direct") and isinstance(boundary, str) \
             and boundary in BOUNDARY_TREATMENTS:
         # a small clean closed mesh: the same values in one compiled call (igl_hhj.small_mesh)
-        out = _small_mesh.try_dropin(V, F, radius, _check_rtol(rtol))
+        out = _small_mesh.try_dropin(V, F, radius, _check_rtol(rtol), boundary)
         if out is not None:
             return out
     try:

@@ -158,7 +158,12 @@ def clamped_load(mesh: TriangleMesh, edge_mask, gradient):
     n = mesh.conormals_at(f, i)                   # (m, 3)
     va, vb = mesh.edges[e, 0], mesh.edges[e, 1]
     xi = 0.5 * (gradient[va] + gradient[vb])      # (m, k, 3) mean over the edge
-    g[e] = mesh.unique_edge_lengths[e, None] * np.einsum("ma,mka->mk", n, xi)
+    # n·ξ summed (n0 ξ0 + n1 ξ1) + n2 ξ2 in this order on every machine (einsum's order
+    # depends on the SIMD width), as the compiled small-mesh path (igl_hhj.small_mesh)
+    s = n[:, None, 0] * xi[:, :, 0]
+    s += n[:, None, 1] * xi[:, :, 1]
+    s += n[:, None, 2] * xi[:, :, 2]
+    g[e] = mesh.unique_edge_lengths[e, None] * s
     return g
 
 

@@ -1,24 +1,30 @@
-"""The drop-in on small closed meshes in one compiled call (issue 24: fixed cost per call).
+"""The drop-in on small meshes in one compiled call (issue 24: fixed cost per call).
 
-:func:`igl_hhj.principal_curvature` validates the mesh, builds its topology, assembles
-and solves the HHJ system, forms S_h, recovers and smooths it at the vertices and
-solves the 2×2 eigen-problems in some forty Python steps of a few microseconds each:
-0.3 ms on a 12-face cube, where ``igl.principal_curvature`` takes 0.05 ms.  Code that
+:func:`igl_hhj.principal_curvature` validates the mesh, builds its topology, estimates
+the boundary normals of an open mesh, assembles and solves the HHJ system, forms S_h,
+recovers and smooths it at the vertices and solves the 2×2 eigen-problems in some
+forty Python steps of a few microseconds each: 0.3 ms on a 12-face cube and 1 ms on an
+18-face open grid, where ``igl.principal_curvature`` takes 0.05 and 0.12 ms.  Code that
 calls the drop-in per frame or over thousands of small parts pays that.
 
-:func:`try_dropin` runs the same compiled kernels in the same order on the same
-inputs in one call (``_hhj_core.dropin_small``, ``igl_hhj/_core/small_mesh.cpp``):
-libigl's vertex normals and cotangent entries are computed here (libigl does what
-libigl does), everything else in the kernel.  It applies to a closed mesh with at
-most :data:`igl_hhj.solvers.ENVELOPE_MAX` edges (the general path's direct solver
-there is the same envelope LDLᵀ) given as numpy arrays, with the default boundary
-options.  Whenever the general path would do anything else -- raise, warn, repair,
-estimate boundary normals, split components into solve groups of another solver,
-fall back to another solver -- the kernel returns a nonzero status and
+:func:`try_dropin` runs the same computation in one call (``_hhj_core.dropin_small``,
+``igl_hhj/_core/small_mesh.cpp``): the same compiled kernels in the same order on the
+same inputs, and the numpy glue between them (the boundary-normal fall-backs of
+:func:`igl_hhj.boundary_estimation.estimate_boundary_normals`, Walker's clamped load
+:func:`igl_hhj.hhj.clamped_load`, :func:`igl_hhj.recovery.smoothing_coefficients`, the
+bad-vertex rules) with the same floating-point operations in the same order, so the
+values are the general path's bit for bit.  libigl's vertex normals and cotangent
+entries are computed here (libigl does what libigl does).
+
+It applies to a mesh with at most :data:`MAX_EDGES` (:data:`igl_hhj.solvers.ENVELOPE_MAX`)
+edges, where the general path's direct solver is the same envelope LDLᵀ, given as numpy
+arrays, with the default options (open meshes with ``boundary="estimate"``).  Whenever
+the general path would do anything else -- raise, warn (an unwelded mesh), repair, use
+another solver or fall back to one -- the kernel returns a nonzero status and
 :func:`try_dropin` returns None: the caller takes the general path, which then does
-exactly that.  ``tests/test_small_mesh.py`` asserts that both paths give the same
-values (to round-off) on closed, multi-component, folded and unreferenced-vertex
-meshes, and that every defect class goes to the general path.
+exactly that.  ``tests/test_small_mesh.py`` asserts that both paths give the same bits
+on closed, open, multi-component, folded and unreferenced-vertex meshes, and that every
+defect class goes to the general path.
 """
 from __future__ import annotations
 
@@ -35,21 +41,28 @@ def _params():
     """The general path's constants, in the order of ``_hhj_core.dropin_small``."""
     global _PARAMS
     if _PARAMS is None:
+        import igl
+
         from . import intrinsic as it
-        from .mesh import DEGENERATE_AREA_RTOL, FOLDED_NORMAL_RTOL, MIN_MESH_SIZE
-        from .recovery import QUALITY_FLOOR, SMOOTHING_PER_RADIUS, _kernel_coefficients
+        from .boundary_estimation import FIT_RINGS, SIDE_DOT_MIN
+        from .mesh import COORDINATE_MAX, DEGENERATE_AREA_RTOL, FOLDED_NORMAL_RTOL, MIN_MESH_SIZE
+        from .recovery import (BOUNDARY_BAND_RINGS, BOUNDARY_LENGTH_FACTOR, QUALITY_FLOOR,
+                               SMOOTHING_PER_RADIUS, _kernel_coefficients)
         from .solvers import DIRECT_RESIDUAL_RTOL
-        checks = (DEGENERATE_AREA_RTOL, MIN_MESH_SIZE, FOLDED_NORMAL_RTOL, QUALITY_FLOOR,
-                  DIRECT_RESIDUAL_RTOL, MAX_EDGES)
+        head = (DEGENERATE_AREA_RTOL, MIN_MESH_SIZE, FOLDED_NORMAL_RTOL, QUALITY_FLOOR,
+                DIRECT_RESIDUAL_RTOL, MAX_EDGES)
+        tail = (int(FIT_RINGS), float(SIDE_DOT_MIN), int(BOUNDARY_BAND_RINGS), float(BOUNDARY_LENGTH_FACTOR))
+        checks = {b: head + (b == "estimate",) + tail for b in ("estimate", "plain")}
         smoothing = (SMOOTHING_PER_RADIUS, float(it.PILOT_RADIUS), float(it.ADAPTIVE_GAIN),
                      float(it.ADAPTIVE_POWER), float(it.ADAPTIVE_RANGE[0]), float(it.ADAPTIVE_RANGE[1]),
                      int(it.SMOOTHING_STEPS))
         binom = [float(c) for c in _kernel_coefficients(it.SMOOTHING_ORDER)]
-        _PARAMS = (checks, smoothing, binom, it.smoothing_rtol)
+        area = igl.PerVertexNormalsWeightingType.PER_VERTEX_NORMALS_WEIGHTING_TYPE_AREA
+        _PARAMS = (checks, smoothing, binom, it.smoothing_rtol, COORDINATE_MAX, area)
     return _PARAMS
 
 
-def try_dropin(V, F, radius, rtol):
+def try_dropin(V, F, radius, rtol, boundary="estimate"):
     """:func:`igl_hhj.principal_curvature` ``(V, F, radius)`` in one compiled call, or None.
 
     Parameters
@@ -58,6 +71,7 @@ def try_dropin(V, F, radius, rtol):
     F : (#F, 3) numpy integer array
     radius : float ≥ 0, the checked smoothing radius
     rtol : float, the checked solver tolerance
+    boundary : {"estimate", "plain"}: open meshes with "plain" take the general path
 
     Returns
     -------
@@ -68,31 +82,22 @@ def try_dropin(V, F, radius, rtol):
             or V.shape[1] != 3 or F.shape[1] != 3 or not 0 < 3 * F.shape[0] <= 2 * MAX_EDGES \
             or V.shape[0] == 0 or F.dtype.kind not in "iu" or V.dtype.kind != "f":
         return None
+    checks, smoothing, binom, smoothing_rtol, coordinate_max, area = _params()
     V = np.ascontiguousarray(V, dtype=np.float64)
     F = np.ascontiguousarray(F, dtype=np.int64)
-    # the general path's coordinate and index checks (NaN fails the comparison)
-    if not np.abs(V).max() <= _coordinate_max() or F.min() < 0 or F.max() >= V.shape[0]:
+    # the general path's coordinate and index checks (NaN fails the comparison), before
+    # libigl reads the arrays
+    if not np.abs(V).max() <= coordinate_max or F.min() < 0 or F.max() >= V.shape[0]:
         return None
     import igl
 
     from . import _hhj_core
-    checks, smoothing, binom, smoothing_rtol = _params()
-    N = igl.per_vertex_normals(V, F, _AREA())
+    N = igl.per_vertex_normals(V, F, area)
     cot = igl.cotmatrix_entries(V, F)
-    srtol = smoothing_rtol(rtol)
     status, PD1, PD2, PV1, PV2, bad = _hhj_core.dropin_small(
-        V, F, np.ascontiguousarray(N, dtype=np.float64), np.ascontiguousarray(cot, dtype=np.float64), checks,
-        (float(radius), smoothing[0], smoothing[1], srtol, *smoothing[2:], 500), binom)
+        V, F, np.ascontiguousarray(N, dtype=np.float64), np.ascontiguousarray(cot, dtype=np.float64),
+        checks[boundary], (float(radius), smoothing[0], smoothing[1], smoothing_rtol(rtol), *smoothing[2:], 500),
+        binom)
     if status != 0:
         return None
     return PD1, PD2, PV1, PV2, np.flatnonzero(bad).tolist()
-
-
-def _coordinate_max():
-    from .mesh import COORDINATE_MAX
-    return COORDINATE_MAX
-
-
-def _AREA():
-    import igl
-    return igl.PerVertexNormalsWeightingType.PER_VERTEX_NORMALS_WEIGHTING_TYPE_AREA

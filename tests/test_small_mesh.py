@@ -1,5 +1,5 @@
 """The compiled small-mesh path of the drop-in (`igl_hhj.small_mesh`, issue 24: fixed cost)
-returns the general path's values bit for bit, and hands every other mesh to it."""
+returns the general path's values bit for bit, closed or open, and hands every other mesh to it."""
 import warnings
 
 import numpy as np
@@ -9,13 +9,13 @@ from conftest import DEFECTS, defect_mesh, fin
 import igl_hhj
 from igl_hhj import curvature, small_mesh
 from igl_hhj.benchmarks.speed import tiny_meshes
-from igl_hhj.mesh import MeshDefectError, as_mesh
-from igl_hhj.surfaces import Sphere, icosphere, jitter_tangentially, torus_coarse
+from igl_hhj.mesh import MeshDefectError, MeshWarning, as_mesh
+from igl_hhj.surfaces import Sphere, icosphere, jitter_tangentially, square_grid, torus_coarse
 
 
-def general(V, F, radius=5, rtol=1e-6):
+def general(V, F, radius=5, rtol=1e-6, boundary="estimate"):
     """The drop-in without the small-mesh path."""
-    return curvature.dropin_on_mesh(as_mesh(V, F), radius, "estimate", None, None, None, "auto", rtol)
+    return curvature.dropin_on_mesh(as_mesh(V, F), radius, boundary, None, None, None, "auto", rtol)
 
 
 def assert_identical(a, b):
@@ -50,10 +50,18 @@ def _jittered_sphere():
     return jitter_tangentially(V, F, Sphere(), 0.3, seed=4) * [1.0, 0.8, 0.6], F
 
 
-CLEAN = {name: (V, F) for name, V, F in tiny_meshes()
-         if not as_mesh(V, F).has_boundary and as_mesh(V, F).n_edges <= small_mesh.MAX_EDGES}
+def _open_meshes():
+    P, F = square_grid(2, amount=0.3, seed=1)
+    V, Fs = icosphere(2)
+    cap = Fs[V[Fs].mean(axis=1)[:, 2] < 0.5]                    # a sphere with a round hole
+    Vt, Ft = torus_coarse(n_phi=8, n_t=6)
+    return {"open grid 8": (np.c_[P, P[:, 0] ** 2 - P[:, 1] ** 2], F), "sphere cap": (V, cap),
+            "sphere minus one face": (icosphere(1)[0], icosphere(1)[1][1:]), "open torus": (Vt, Ft[4:])}
+
+
+CLEAN = {name: (V, F) for name, V, F in tiny_meshes() if as_mesh(V, F).n_edges <= small_mesh.MAX_EDGES}
 CLEAN.update({"two parts": _two_parts(), "unreferenced vertex": _unreferenced(), "pillow": _pillow(),
-              "jittered ellipsoid": _jittered_sphere()})
+              "jittered ellipsoid": _jittered_sphere(), **_open_meshes()})
 
 
 @pytest.mark.parametrize("name", sorted(CLEAN))
@@ -67,7 +75,24 @@ def test_same_bits_as_the_general_path(name, radius, rtol):
 
 
 def test_the_benchmarks_closed_meshes_are_covered():
-    assert {"octahedron", "cube", "icosphere(0)", "icosphere(1)", "icosphere(2)", "torus 96"} <= set(CLEAN)
+    assert {"octahedron", "cube", "icosphere(0)", "icosphere(1)", "icosphere(2)", "torus 96", "open grid 18",
+            "open grid 128"} <= set(CLEAN)
+    assert sum(as_mesh(*m).has_boundary for m in CLEAN.values()) >= 6
+
+
+def test_open_meshes_plain_and_unwelded_take_the_general_path():
+    """boundary="plain" on an open mesh, and an unwelded mesh (the general path warns)."""
+    V, F = _open_meshes()["sphere cap"]
+    assert small_mesh.try_dropin(V, F, 5, 1e-6, "plain") is None
+    assert_identical(igl_hhj.principal_curvature(V, F, boundary="plain"), general(V, F, boundary="plain"))
+    assert small_mesh.try_dropin(*icosphere(1), 5, 1e-6, "plain") is not None     # closed: no boundary
+    P, Fg = square_grid(3, amount=0.0)
+    Vg = np.c_[P, 0 * P[:, 0]]
+    Vu = np.vstack([Vg, Vg])                                    # two copies, one seam apart: unwelded
+    Fu = np.vstack([Fg[: len(Fg) // 2], Fg[len(Fg) // 2:] + len(Vg)])
+    assert small_mesh.try_dropin(Vu, Fu, 5, 1e-6) is None
+    with pytest.warns(MeshWarning, match="unwelded"):
+        igl_hhj.principal_curvature(Vu, Fu)
 
 
 def test_bad_vertices_are_the_general_paths():
@@ -98,7 +123,7 @@ def test_defects_take_the_general_path(seed):
         except (MeshDefectError, Warning):
             assert out is None, kinds
             return
-    if mesh.has_boundary or mesh.n_edges > small_mesh.MAX_EDGES:
+    if mesh.n_edges > small_mesh.MAX_EDGES:
         assert out is None, kinds
     else:
         assert_identical(out, general(V, F))
@@ -106,7 +131,7 @@ def test_defects_take_the_general_path(seed):
 
 def test_every_defect_class_is_refused():
     V, F = icosphere(1)
-    cases = {"open": (V, F[1:]), "fin": fin(V, F)[:2], "flip": (V, np.vstack([F[:1, ::-1], F[1:]])),
+    cases = {"fin": fin(V, F)[:2], "flip": (V, np.vstack([F[:1, ::-1], F[1:]])),
              "duplicate": (V, np.vstack([F, F[:1]])), "repeated corner": (V, np.vstack([F, [[0, 0, 1]]])),
              "too large": icosphere(3)}
     Vz = V.copy()

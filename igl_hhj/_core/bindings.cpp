@@ -514,7 +514,7 @@ NB_MODULE(_hhj_core, m) {
              cot.shape(0) == (size_t)nF && cot.shape(1) == 3, "dropin_small: N, cot shapes");
         need(nV > 0 && nF > 0 && nF < ((i64)1 << 24), "dropin_small: mesh size");
         for (i64 q = 0; q < 3 * nF; ++q) need(F.data()[q] >= 0 && F.data()[q] < nV, "dropin_small: F out of range");
-        need(checks.size() == 6 && smoothing.size() == 10, "dropin_small: parameter tuples");
+        need(checks.size() == 11 && smoothing.size() == 10, "dropin_small: parameter tuples");
         hhj::SmallParams p;
         p.degenerate_rtol = nb::cast<double>(checks[0]);
         p.min_mesh_size = nb::cast<double>(checks[1]);
@@ -522,6 +522,12 @@ NB_MODULE(_hhj_core, m) {
         p.quality_floor = nb::cast<double>(checks[3]);
         p.direct_rtol = nb::cast<double>(checks[4]);
         p.max_edges = nb::cast<i64>(checks[5]);
+        p.estimate = nb::cast<bool>(checks[6]);
+        p.fit_rings = nb::cast<int>(checks[7]);
+        p.side_dot_min = nb::cast<double>(checks[8]);
+        p.band_rings = nb::cast<int>(checks[9]);
+        p.band_factor = nb::cast<double>(checks[10]);
+        need(p.fit_rings >= 1 && p.band_rings >= 0, "dropin_small: rings");
         p.radius = nb::cast<double>(smoothing[0]);
         p.per_radius = nb::cast<double>(smoothing[1]);
         p.pilot_radius = nb::cast<double>(smoothing[2]);

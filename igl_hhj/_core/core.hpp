@@ -270,11 +270,16 @@ PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const d
 int envelope_ldl_solve(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const double* Ax,
                        const double* R, double* X, double resid_rtol);
 
-// small_mesh.cpp: the drop-in on a small closed mesh in one call (issue 24, fixed cost).
+// small_mesh.cpp: the drop-in on a small mesh in one call (issue 24, fixed cost).
 // The parameters are the Python constants of the general path (igl_hhj.small_mesh).
 struct SmallParams {
     double degenerate_rtol, min_mesh_size, folded_rtol, quality_floor, direct_rtol;
     i64 max_edges;            // the envelope solver's limit (solvers.ENVELOPE_MAX)
+    bool estimate;            // boundary="estimate" (else an open mesh takes the general path)
+    int fit_rings;            // boundary_estimation.FIT_RINGS
+    double side_dot_min;      // boundary_estimation.SIDE_DOT_MIN
+    int band_rings;           // recovery.BOUNDARY_BAND_RINGS
+    double band_factor;       // recovery.BOUNDARY_LENGTH_FACTOR
     double radius, per_radius, pilot_radius, smoothing_rtol, gain, power, lo, hi;
     int steps;
     std::vector<double> binom;

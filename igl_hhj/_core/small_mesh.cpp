@@ -8,6 +8,7 @@
 // compares them); anything else -- an open boundary, a defect the general path would
 // refuse or repair, more edges than the envelope solver takes, a solve that fails --
 // returns a nonzero status and the caller takes the general path.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -41,6 +42,20 @@ double pairwise_sum(const double* a, i64 n) {
     return pairwise_sum(a, n2) + pairwise_sum(a + n2, n - n2);
 }
 
+// Whether two of the rows `rows` of V (#V, 3) hold the same coordinates (mesh._warn_unwelded).
+bool coincident_rows(const double* V, const std::vector<i64>& rows) {
+    std::vector<i64> o(rows);
+    auto less = [&](i64 a, i64 b) {
+        for (int k = 0; k < 3; ++k)
+            if (V[3 * a + k] != V[3 * b + k]) return V[3 * a + k] < V[3 * b + k];
+        return false;
+    };
+    std::sort(o.begin(), o.end(), less);
+    for (size_t q = 1; q < o.size(); ++q)
+        if (!less(o[q - 1], o[q])) return true;
+    return false;
+}
+
 }  // namespace
 
 int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0, const double* cot,
@@ -67,10 +82,19 @@ int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0
     std::vector<int> positive(nE, 0);
     for (i64 q = 0; q < 3 * nF; ++q)
         if (T.sign[q] > 0) ++positive[T.face_edges[q]];
+    std::vector<i64> bnd_edges;                                      // ascending
     for (i64 e = 0; e < nE; ++e) {
-        if (T.count[e] == 1) return SMALL_OPEN;                      // the boundary estimation
+        if (T.count[e] == 1) { bnd_edges.push_back(e); continue; }
         if (T.count[e] != 2 || positive[e] != 1) return SMALL_DEFECT;  // non-manifold, orientation
     }
+    const i64 nb = (i64)bnd_edges.size();
+    if (nb > 0 && !p.estimate) return SMALL_OPEN;                    // boundary="plain": general path
+    std::vector<unsigned char> on_boundary(nV, 0);
+    for (i64 e : bnd_edges) on_boundary[T.edges[2 * e]] = on_boundary[T.edges[2 * e + 1]] = 1;
+    std::vector<i64> bverts;                                          // ascending
+    for (i64 v = 0; v < nV; ++v)
+        if (on_boundary[v]) bverts.push_back(v);
+    if (coincident_rows(V, bverts)) return SMALL_DEFECT;              // unwelded: the general path warns
     // ---- referenced and folded vertices (TriangleMesh.folded_vertices), the normals
     std::vector<unsigned char> ref(nV, 0);
     for (i64 q = 0; q < 3 * nF; ++q) ref[F[q]] = 1;
@@ -82,6 +106,81 @@ int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0
         folded[v] = ref[v] && std::sqrt(sv[0] * sv[0] + sv[1] * sv[1] + sv[2] * sv[2]) <= p.folded_rtol * asum[v];
         if (!ref[v] || folded[v])
             for (int a = 0; a < 3; ++a) N[3 * v + a] = NAN;
+    }
+    // ---- boundary="estimate" (boundary_estimation.estimate_boundary_normals; curvature's
+    // _boundary_partition, _normalised_boundary_normals, _boundary_rhs; hhj.clamped_load)
+    std::vector<double> Nb;                     // (nV, 3) clamped normals, NaN: plain edge
+    std::vector<unsigned char> clamped(nE, 0);
+    std::vector<i64> bface(nb), bloc(nb);       // the boundary edges' face and local index
+    for (i64 q = 0; q < nb; ++q) {
+        const i64 e = bnd_edges[q];
+        const bool first = T.edge_faces[2 * e] >= 0;
+        bface[q] = first ? T.edge_faces[2 * e] : T.edge_faces[2 * e + 1];
+        bloc[q] = first ? T.local_index[2 * e] : T.local_index[2 * e + 1];
+    }
+    if (nb > 0) {
+        const i64 n = (i64)bverts.size();
+        std::vector<double> N0((size_t)n * 3), Nfit((size_t)n * 3);
+        for (i64 q = 0; q < n; ++q)
+            for (int a = 0; a < 3; ++a) N0[3 * q + a] = N[3 * bverts[q] + a];
+        boundary_normal_fits(V, nV, T.edges.data(), nE, bverts.data(), n, p.fit_rings, N0.data(), Nfit.data(), 1);
+        std::vector<double> fn((size_t)nb * 3), full((size_t)nV * 3, 0.0);
+        for (i64 q = 0; q < nb; ++q)
+            for (int a = 0; a < 3; ++a) fn[3 * q + a] = cross[3 * bface[q] + a] / dbl[bface[q]];
+        for (int col = 0; col < 2; ++col)
+            for (i64 q = 0; q < nb; ++q)
+                for (int a = 0; a < 3; ++a) full[3 * T.edges[2 * bnd_edges[q] + col] + a] += fn[3 * q + a];
+        Nb.assign((size_t)nV * 3, NAN);
+        for (i64 q = 0; q < n; ++q)
+            for (int a = 0; a < 3; ++a) Nb[3 * bverts[q] + a] = Nfit[3 * q + a];
+        auto side = [&](i64 v, i64 q) {          // (a0 b0 + a1 b1) + a2 b2 > SIDE_DOT_MIN
+            const double* x = &Nb[3 * v];
+            const double* y = &fn[3 * q];
+            double d = x[0] * y[0];
+            d += x[1] * y[1];
+            d += x[2] * y[2];
+            return d > p.side_dot_min;
+        };
+        std::vector<unsigned char> flag(nV);
+        for (int col = 0; col < 2; ++col) {     // the faces' mean normal where the fit looks away
+            std::fill(flag.begin(), flag.end(), 0);
+            for (i64 q = 0; q < nb; ++q) {
+                const i64 v = T.edges[2 * bnd_edges[q] + col];
+                if (!side(v, q)) flag[v] = 1;
+            }
+            for (i64 v = 0; v < nV; ++v)
+                if (flag[v]) {
+                    const double* f = &full[3 * v];
+                    const double nf = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+                    for (int a = 0; a < 3; ++a) Nb[3 * v + a] = f[a] / nf;
+                }
+        }
+        for (int col = 0; col < 2; ++col) {     // no normal where even that looks away
+            std::fill(flag.begin(), flag.end(), 0);
+            for (i64 q = 0; q < nb; ++q) {
+                const i64 v = T.edges[2 * bnd_edges[q] + col];
+                if (!side(v, q)) flag[v] = 1;
+            }
+            for (i64 v = 0; v < nV; ++v)
+                if (flag[v])
+                    for (int a = 0; a < 3; ++a) Nb[3 * v + a] = NAN;
+        }
+        auto usable = [&](i64 v) {
+            return std::isfinite(Nb[3 * v]) && std::isfinite(Nb[3 * v + 1]) && std::isfinite(Nb[3 * v + 2]);
+        };
+        std::fill(flag.begin(), flag.end(), 0);
+        for (i64 e : bnd_edges)
+            if (usable(T.edges[2 * e]) && usable(T.edges[2 * e + 1])) {
+                clamped[e] = 1;
+                flag[T.edges[2 * e]] = flag[T.edges[2 * e + 1]] = 1;
+            }
+        for (i64 v = 0; v < nV; ++v)            // normalised on the clamped edges' vertices
+            if (flag[v]) {
+                double* x = &Nb[3 * v];
+                const double nn = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+                if (nn < 1e-12) return SMALL_DEFECT;
+                for (int a = 0; a < 3; ++a) x[a] /= nn;
+            }
     }
     // ---- HHJ system in the Morton numbering and its direct solve (HHJSystem, "direct")
     std::vector<i64> perm(nE), iperm(nE);
@@ -100,8 +199,49 @@ int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0
     assemble_ell(Aloc.data(), FEp.data(), EFp.data(), ELIp.data(), nE, cols.data(), A.data(), 1);
     std::vector<double> load((size_t)nE * 3), R((size_t)nE * 3), X((size_t)nE * 3);
     jump_apply(V, F, nF, T.edge_faces.data(), T.local_index.data(), nE, V, 3, load.data(), 1);   // B X
+    for (i64 q = 0; q < 3 * nE; ++q) load[q] = -load[q];                                      // -B X
+    std::vector<double> len(nE);
+    for (i64 e = 0; e < nE; ++e) {
+        const double* a = V + 3 * T.edges[2 * e];
+        const double* b = V + 3 * T.edges[2 * e + 1];
+        const double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        len[e] = std::sqrt((d[0] * d[0] + d[1] * d[1]) + d[2] * d[2]);
+    }
+    for (i64 q = 0; q < nb; ++q) {
+        const i64 e = bnd_edges[q];
+        double* row = &load[3 * e];
+        if (!clamped[e]) { row[0] = row[1] = row[2] = 0.0; continue; }   // plain assembly
+        // g_e^k = l_e n·ξ^k, ξ^k the mean over the edge of row k of P = I - ν~ ⊗ ν~
+        const i64 f = bface[q];
+        const int i = (int)bloc[q];
+        const double* x1 = V + 3 * F[3 * f + (i + 1) % 3];
+        const double* x2 = V + 3 * F[3 * f + (i + 2) % 3];
+        double t[3] = {x2[0] - x1[0], x2[1] - x1[1], x2[2] - x1[2]};
+        const double tl = std::sqrt((t[0] * t[0] + t[1] * t[1]) + t[2] * t[2]);
+        for (int a = 0; a < 3; ++a) t[a] /= tl;
+        double nu[3], cn[3];
+        for (int a = 0; a < 3; ++a) nu[a] = cross[3 * f + a] / dbl[f];
+        cross3(t, nu, cn);
+        double xi[3][3];
+        for (int k = 0; k < 3; ++k)
+            for (int a = 0; a < 3; ++a) {
+                double pe[2];
+                for (int c = 0; c < 2; ++c) {
+                    const double* nv = &Nb[3 * T.edges[2 * e + c]];
+                    const double v = (k == a ? 1.0 : 0.0) - nv[k] * nv[a];
+                    pe[c] = std::isfinite(v) ? v : 0.0;
+                }
+                xi[k][a] = 0.5 * (pe[0] + pe[1]);
+            }
+        for (int k = 0; k < 3; ++k) {
+            double g = cn[0] * xi[k][0];
+            g += cn[1] * xi[k][1];
+            g += cn[2] * xi[k][2];
+            row[k] += len[e] * g;
+        }
+    }
     for (i64 i = 0; i < nE; ++i)
-        for (int k = 0; k < 3; ++k) R[3 * i + k] = -load[3 * perm[i] + k];                     // -B X
+        for (int k = 0; k < 3; ++k) R[3 * i + k] = load[3 * perm[i] + k];
     std::vector<i64> indptr(nE + 1);
     for (i64 i = 0; i <= nE; ++i) indptr[i] = 5 * i;
     if (envelope_ldl_solve(nE, 3, indptr.data(), cols.data(), A.data(), R.data(), X.data(), p.direct_rtol) != 0)
@@ -117,24 +257,30 @@ int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0
     // ---- the vertex stage (intrinsic.vertex_stage): recovery, then the smoothing
     std::vector<double> w(nF);
     recovery_weights(V, F, nF, T.face_edges.data(), T.edge_faces.data(), nE, p.quality_floor, w.data(), 1);
-    std::vector<double> len(nE);
-    for (i64 e = 0; e < nE; ++e) {
-        const double* a = V + 3 * T.edges[2 * e];
-        const double* b = V + 3 * T.edges[2 * e + 1];
-        const double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-        len[e] = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    }
     const double h = pairwise_sum(len.data(), nE) / (double)nE;
     std::vector<double> Xv((size_t)nV * 3), rough(nV);
     intrinsic_patch_recovery(V, F, nF, nV, S.data(), N.data(), w.data(), ref.data(), h, Xv.data(), rough.data(), 1);
     if (p.radius > 0) {
-        // recovery.smoothing_coefficients on a closed mesh (no boundary band)
+        // recovery.smoothing_coefficients: b_T² = BOUNDARY_LENGTH_FACTOR² on faces touching
+        // the boundary band (recovery.boundary_band: BOUNDARY_BAND_RINGS dilations)
+        std::vector<unsigned char> band(on_boundary), grown;
+        if (nb > 0)
+            for (int ring = 0; ring < p.band_rings; ++ring) {
+                grown = band;
+                for (i64 e = 0; e < nE; ++e) {
+                    if (band[T.edges[2 * e + 1]]) grown[T.edges[2 * e]] = 1;
+                    if (band[T.edges[2 * e]]) grown[T.edges[2 * e + 1]] = 1;
+                }
+                band.swap(grown);
+            }
         std::vector<double> C((size_t)nF * 3), m(nV, 0.0);
         for (i64 f = 0; f < nF; ++f) {
             const double area = 0.5 * dbl[f];
             const double fac = area > 0 ? w[f] / area : 0.0;
+            const bool near = nb > 0 && (band[F[3 * f]] || band[F[3 * f + 1]] || band[F[3 * f + 2]]);
+            const double stiff = nb > 0 ? fac * (near ? p.band_factor * p.band_factor : 1.0) : fac;
             for (int c = 0; c < 3; ++c) {
-                const double x = cot[3 * f + c] * fac;
+                const double x = cot[3 * f + c] * stiff;
                 C[3 * f + c] = std::isfinite(x) ? x : 0.0;
             }
         }
