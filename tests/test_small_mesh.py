@@ -191,3 +191,31 @@ def test_options_the_small_path_does_not_cover():
         igl_hhj.principal_curvature(V, F, rtol=2.0)
     with pytest.raises(ValueError, match="solver"):
         igl_hhj.principal_curvature(V, F, solver="nope")
+
+
+def test_fuzz_scaled_perturbed_subsets():
+    """400 generated meshes: face subsets (open, with corners and bow-ties), normal jitter,
+    coordinate scales 1e-30-1e30, radii 1-8: wherever the compiled path answers it gives the
+    general path's bits, and it answers for most of them."""
+    rng = np.random.default_rng(7)
+    P, Fg = square_grid(5, amount=0.3)
+    base = [icosphere(1), icosphere(2), torus_coarse(n_phi=8, n_t=6), (np.c_[P, P[:, 0] * P[:, 1]], Fg),
+            (np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0.0]]), np.array([[0, 1, 2]])),
+            (np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [-1, 0, 0.2], [0, -1, 0.1]]),
+             np.array([[0, 1, 2], [0, 3, 4]]))]                        # a bow-tie
+    answered = 0
+    for _ in range(400):
+        V, F = base[rng.integers(len(base))]
+        if rng.random() < 0.5 and len(F) > 3:
+            F = F[rng.random(len(F)) < rng.uniform(0.3, 1.0)]
+            if len(F) == 0:
+                continue
+        V = (V + rng.normal(scale=rng.choice([0, 1e-3, 0.05]), size=V.shape)) * 10.0 ** rng.uniform(-30, 30)
+        radius = int(rng.choice([1, 2, 5, 8]))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            out = small_mesh.try_dropin(V, F, radius, 1e-6)
+            if out is not None:
+                answered += 1
+                assert_identical(out, general(V, F, radius))
+    assert answered >= 300
