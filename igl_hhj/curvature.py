@@ -769,7 +769,7 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
     """
     check_principal_curvature_args(radius, useKring)
     try:
-        mesh = as_mesh(V, F)
+        mesh = as_mesh(V, F, copy=False)     # private to this call: views, not copies, of V, F
     except MeshDefectError as exc:       # repairable defect: repair, compute, map back (issue 24)
         from .repair import repaired_principal_curvature
         kw = dict(boundary=boundary, boundary_normals=boundary_normals,
