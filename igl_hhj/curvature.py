@@ -782,17 +782,24 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
                               solver=solver, rtol=rtol,
                               data=(boundary_normals, boundary_shape_operator, simply_supported))
     return dropin_on_mesh(mesh, radius, boundary, boundary_normals, boundary_shape_operator,
-                          simply_supported, solver, rtol)
+                          simply_supported, solver, rtol, release=True)
 
 
 def dropin_on_mesh(mesh, radius, boundary, boundary_normals, boundary_shape_operator, simply_supported,
-                   solver, rtol):
+                   solver, rtol, release=False):
     """:func:`principal_curvature` on a validated :class:`~igl_hhj.mesh.TriangleMesh` (also
     the cut mesh of :mod:`igl_hhj.features`): the boundary treatment, S_h
-    (:func:`_shape_operator`), then :func:`dropin_vertex_values`."""
+    (:func:`_shape_operator`), then :func:`dropin_vertex_values`.  ``release``: the mesh's
+    face cross products (24 B/face) are dropped from its cache before the solve, the call's
+    memory peak (for a mesh that needs them no more afterwards)."""
     boundary_normals, treatment = _resolve_boundary(mesh, boundary, boundary_normals,
                                                     boundary_shape_operator)
     rtol = _check_rtol(rtol)
+    if release:
+        # the vertex stage's normals now, then the face cross products they come from
+        # (recomputed by the same compiled pass if asked for again) are released
+        mesh.vertex_normals
+        mesh.__dict__.pop("_cross", None)
     S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver,
                         rtol, estimated=treatment == "estimate")
     holder = [S]     # the only reference: the vertex stage frees S before smoothing
