@@ -782,14 +782,14 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
     """
     check_principal_curvature_args(radius, useKring)
     if feature_angle is None and boundary_normals is None and boundary_shape_operator is None \
-            and simply_supported is None and isinstance(solver, str) and solver in ("auto", "direct") and isinstance(boundary, str) \
-            and boundary in BOUNDARY_TREATMENTS:
-        # a small clean closed mesh: the same values in one compiled call (igl_hhj.small_mesh)
+            and simply_supported is None and isinstance(solver, str) and solver in ("auto", "direct") \
+            and isinstance(boundary, str) and boundary in BOUNDARY_TREATMENTS:
+        # a small clean mesh: the same values in one compiled call (igl_hhj.small_mesh)
         out = _small_mesh.try_dropin(V, F, radius, _check_rtol(rtol), boundary)
         if out is not None:
             return out
     try:
-        mesh = as_mesh(V, F)
+        mesh = as_mesh(V, F, copy=False)     # private to this call: views, not copies, of V, F
     except MeshDefectError as exc:       # repairable defect: repair, compute, map back (issue 24)
         from .repair import repaired_principal_curvature
         kw = dict(boundary=boundary, boundary_normals=boundary_normals,
@@ -802,18 +802,26 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
                               solver=solver, rtol=rtol,
                               data=(boundary_normals, boundary_shape_operator, simply_supported))
     return dropin_on_mesh(mesh, radius, boundary, boundary_normals, boundary_shape_operator,
-                          simply_supported, solver, rtol)
+                          simply_supported, solver, rtol, release=True)
 
 
 def dropin_on_mesh(mesh, radius, boundary, boundary_normals, boundary_shape_operator, simply_supported,
-                   solver, rtol, groups_of=None):
+                   solver, rtol, groups_of=None, release=False):
     """:func:`principal_curvature` on a validated :class:`~igl_hhj.mesh.TriangleMesh` (also
     the cut mesh of :mod:`igl_hhj.features`, with ``groups_of`` the uncut mesh, see
     :func:`_shape_operator`): the boundary treatment, S_h (:func:`_shape_operator`), then
-    :func:`dropin_vertex_values`."""
+    :func:`dropin_vertex_values`.  ``release``: the mesh's face cross products (24 B/face)
+    are dropped from its cache before the solve, the call's memory peak (for a mesh that
+    needs them no more afterwards)."""
     boundary_normals, treatment = _resolve_boundary(mesh, boundary, boundary_normals,
                                                     boundary_shape_operator)
     rtol = _check_rtol(rtol)
+    if release:
+        # the vertex stage's normals now, then the face cross products they come from are
+        # released (the default path does not read them again; if asked for, the numpy
+        # property recomputes them, equal to round-off)
+        mesh.vertex_normals
+        mesh.__dict__.pop("_cross", None)
     S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver,
                         rtol, estimated=treatment == "estimate", groups_of=groups_of)
     holder = [S]     # the only reference: the vertex stage frees S before smoothing

@@ -234,12 +234,16 @@ class TriangleMesh:
         (an unwelded mesh or triangle soup: its seams count as boundary).
     """
 
-    def __init__(self, V, F):
+    def __init__(self, V, F, *, copy=True):
         V = validate_vertices(V)
         F = validate_faces(F, V.shape[0])
-        # read-only copies: nothing can change the arrays after validation
-        self.V = np.array(V, dtype=np.float64, order="C")
-        self.F = np.array(F, dtype=np.int64, order="C")
+        # read-only copies: nothing can change the arrays after validation.  copy=False
+        # (a mesh private to one call, e.g. the drop-in's): read-only views of V and F when
+        # they already are C-contiguous float64 / int64 (memory: 36 B/face less)
+        self.V = np.array(V, dtype=np.float64, order="C", copy=None if not copy else True)
+        self.F = np.array(F, dtype=np.int64, order="C", copy=None if not copy else True)
+        if not copy:
+            self.V, self.F = self.V.view(), self.F.view()
         self.V.setflags(write=False)
         self.F.setflags(write=False)
         self._check_degenerate()
@@ -570,12 +574,15 @@ class TriangleMesh:
                 stacklevel=3)
 
 
-def as_mesh(V: Any, F: ArrayLike | None = None) -> TriangleMesh:
+def as_mesh(V: Any, F: ArrayLike | None = None, *, copy: bool = True) -> TriangleMesh:
     """Return a :class:`TriangleMesh` for ``(V, F)``; a ``TriangleMesh`` passes through.
 
     With ``F`` None, ``V`` may also be a mesh object of another library
     (``trimesh.Trimesh``, triangulated ``pyvista.PolyData``, ``meshio.Mesh``;
-    duck-typed by :func:`igl_hhj.interop.mesh_arrays`).
+    duck-typed by :func:`igl_hhj.interop.mesh_arrays`).  ``copy=False``: the mesh keeps
+    read-only views of ``V`` and ``F`` where no conversion is needed (for a mesh that
+    does not outlive the call that builds it; the caller must not modify ``V``, ``F``
+    meanwhile).
     """
     if isinstance(V, TriangleMesh) and F is None:
         return V
@@ -585,8 +592,8 @@ def as_mesh(V: Any, F: ArrayLike | None = None) -> TriangleMesh:
         if arrays is None:
             raise TypeError("F is required unless V is a TriangleMesh or a mesh object "
                             "(trimesh.Trimesh, pyvista.PolyData, meshio.Mesh)")
-        return TriangleMesh(*arrays)
-    return TriangleMesh(V, F)
+        return TriangleMesh(*arrays, copy=copy)
+    return TriangleMesh(V, F, copy=copy)
 
 
 def validate_mesh(V: ArrayLike, F: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.int64]]:

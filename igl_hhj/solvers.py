@@ -319,9 +319,11 @@ class HHJSystem:
         n = mesh.n_edges
         # Internally the edges are renumbered along a Morton curve (memory locality of
         # the sparse sweeps: 5-10x faster PCG iterations than the lexicographic order).
-        self.perm = kernels.edge_morton_order(mesh)          # new -> old
+        # int32 permutations where #E allows (memory: 12 B/face less at the solve)
+        idx = np.int32 if n < 2**31 else np.int64
+        self.perm = kernels.edge_morton_order(mesh).astype(idx)          # new -> old
         iperm = np.empty_like(self.perm)
-        iperm[self.perm] = np.arange(n)
+        iperm[self.perm] = np.arange(n, dtype=idx)
         self._iperm = iperm
         # np.take: 4-6x faster than fancy indexing for these row gathers
         topo = (np.take(iperm, mesh.face_edges), np.take(mesh.edge_faces, self.perm, axis=0),
