@@ -382,6 +382,32 @@ def test_vertex_stage_bit_identical_across_thread_counts():
     assert np.array_equal(one, two)
 
 
+def test_smoothing_of_several_parts_bit_identical_across_thread_counts():
+    """The intrinsic smoothing of a mesh with several parts (per-part CG scalars) runs its
+    reductions in parallel chunks: the same bits on one and two threads (>= 20k vertices,
+    where the kernel takes two)."""
+    from igl_hhj.intrinsic import vertex_stage
+    from igl_hhj.surfaces import icosphere
+    V0, F0 = icosphere(5)
+    V = np.vstack([V0, 0.5 * V0 * [1.0, 0.8, 0.6] + 3.0])
+    F = np.vstack([F0, F0 + len(V0)])
+    m = TriangleMesh(V, F)
+    assert m.n_vertices >= 20000
+    S = _shape_operator(m, None, None, None, "cg", 1e-10)
+    nt = kernels.max_threads()
+    adapt, kernels.ADAPT_TO_LOAD = kernels.ADAPT_TO_LOAD, False
+    try:
+        kernels.set_num_threads(1)
+        one, _ = vertex_stage(m, S, 5, info=(i1 := {}))
+        kernels.set_num_threads(max(2, nt))
+        two, _ = vertex_stage(m, S, 5, info=(i2 := {}))
+    finally:
+        kernels.set_num_threads(nt)
+        kernels.ADAPT_TO_LOAD = adapt
+    assert i1["components"] == i2["components"] == 2
+    assert np.array_equal(one, two)
+
+
 def test_vertex_kernels_reject_bad_arrays(closed):
     S = np.zeros((closed.n_faces, 3, 3))
     with pytest.raises(ValueError, match="patch_recovery"):

@@ -44,10 +44,15 @@ void apply(const HZSystem& S, const double* x, double* y, int nt) {
     }
 }
 
+// Several groups in parallel while chunks x groups stay below this (the partial sums are
+// zeroed and summed at every reduction); above it one serial pass.
+constexpr i64 GROUP_CHUNK_MAX = 1 << 14;
+
 // Row reductions: fn(row, vals) adds row's contributions vals[k][part] (k < K quantities,
 // part 0: h, part 1: z) and may write that row's entries of the work vectors.  out[(k ng +
 // g) 2 + part] receives the sums per group g.  One group: fixed chunks in parallel, then a
-// serial sum over the chunks (the same bits for any thread count); several: one serial pass.
+// serial sum over the chunks (the same bits for any thread count); several groups: the same
+// per group while chunks x groups <= GROUP_CHUNK_MAX, else one serial pass.
 template <int K, class RowFn>
 void reduce_rows(i64 n, const std::int32_t* group, i64 ng, int nt, std::vector<double>& out, RowFn fn) {
     out.assign((size_t)K * ng * 2, 0.0);
@@ -70,6 +75,27 @@ void reduce_rows(i64 n, const std::int32_t* group, i64 ng, int nt, std::vector<d
             for (int k = 0; k < K; ++k) { out[2 * k] += part[(c * K + k) * 2]; out[2 * k + 1] += part[(c * K + k) * 2 + 1]; }
         return;
     }
+    const i64 nch = (n + CHUNK - 1) / CHUNK;
+    if (nch > 1 && nch * ng <= GROUP_CHUNK_MAX) {
+        // several groups, few enough: per-chunk partial sums of every group in parallel, then
+        // a serial sum over the chunks (the same bits for any thread count)
+        std::vector<double> part((size_t)nch * K * ng * 2, 0.0);
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+        for (i64 c = 0; c < nch; ++c) {
+            double* pc = &part[(size_t)c * K * ng * 2];
+            for (i64 r = c * CHUNK; r < std::min(n, (c + 1) * CHUNK); ++r) {
+                double v[K][2] = {};
+                fn(r, v);
+                const i64 g = group[r];
+                for (int k = 0; k < K; ++k) { pc[(k * ng + g) * 2] += v[k][0]; pc[(k * ng + g) * 2 + 1] += v[k][1]; }
+            }
+        }
+        for (i64 c = 0; c < nch; ++c)
+            for (i64 q = 0; q < K * ng * 2; ++q) out[q] += part[(size_t)c * K * ng * 2 + q];
+        return;
+    }
     for (i64 r = 0; r < n; ++r) {
         double v[K][2] = {};
         fn(r, v);
@@ -86,7 +112,7 @@ int pcg_hz(const HZSystem& S, const std::int32_t* group, i64 ng, const double* b
     const i64 n = S.n;
     const size_t n3 = (size_t)n * 3;
     const size_t np = (size_t)ng * 2;
-    const int th = ng == 1 ? nt : 1;
+    const int th = nt;      // reduce_rows: the same bits for any thread count, one group or several
     std::vector<double> r(b, b + n3), p(n3), q(n3), red;
     std::vector<double> bb(np), rz(np), alpha(np), beta(np);
     std::vector<unsigned char> done(np, 0);
