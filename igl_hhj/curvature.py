@@ -274,6 +274,14 @@ def _shape_operator_reference(mesh, boundary_normals=None, boundary_shape_operat
     return np.einsum("fj,fjab->fab", c, proj.phi)
 
 
+def _no_named_creases_on_repair(crease_edges, exc):
+    """Named creases refer to the caller's vertices, which a repair renumbers: refused."""
+    if crease_edges is not None:
+        raise ValueError(f"crease_edges cannot be used on a mesh that needs repair ({exc}); repair "
+                         f"it first (igl_hhj.repair.repair_mesh) and name the creases on the "
+                         f"repaired mesh") from exc
+
+
 def _check_rtol(rtol):
     if isinstance(rtol, (bool, np.bool_)) or not isinstance(rtol, (int, float, np.floating, np.integer)):
         raise TypeError(f"rtol must be a float, got {type(rtol).__name__}")
@@ -289,7 +297,8 @@ def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary: str = "estim
                    boundary_normals: ArrayLike | None = None,
                    boundary_shape_operator: ArrayLike | None = None, simply_supported: ArrayLike | None = None,
                    solver: str = "auto", rtol: float = DEFAULT_RTOL, repair: bool = False,
-                   feature_angle: float | None = None) -> NDArray[np.float64]:
+                   feature_angle: float | None = None,
+                   crease_edges: ArrayLike | None = None) -> NDArray[np.float64]:
     """Walker's HHJ approximation S_h of the shape operator ∇_Γν, one tensor per face.
 
     Solves ``A s^k = -B X^k + g^k`` for the three coordinate functions
@@ -342,6 +351,10 @@ def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary: str = "estim
         degrees and clamp each side with its own estimated normals
         (:func:`igl_hhj.features.feature_shape_operator`); the creases' curvature (a
         line measure) is then not in S_h but in :func:`igl_hhj.features.crease_network`.
+    crease_edges : (k, 2) array_like of int, optional
+        Creases named by their vertex pairs (either order), cut in addition to those of
+        ``feature_angle`` (alone when ``feature_angle`` is None): scanned or CAD creases
+        that are known rather than detected (:func:`igl_hhj.features.crease_edges`).
 
     Returns
     -------
@@ -382,11 +395,12 @@ def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary: str = "estim
         kw = dict(boundary=boundary, boundary_normals=boundary_normals,
                   boundary_shape_operator=boundary_shape_operator, simply_supported=simply_supported,
                   solver=solver, rtol=rtol, feature_angle=feature_angle)
+        _no_named_creases_on_repair(crease_edges, exc)
         return repaired_shape_operator(shape_operator, exc, V, F, kw)
     groups_of = None
-    if feature_angle is not None:
+    if feature_angle is not None or crease_edges is not None:
         from .features import _prepare
-        groups_of, _, _, mesh = _prepare(mesh, None, feature_angle, None, boundary,
+        groups_of, _, _, mesh = _prepare(mesh, None, feature_angle, crease_edges, boundary,
                                          (boundary_normals, boundary_shape_operator, simply_supported))
     return _checked_shape_operator(mesh, boundary, boundary_normals, boundary_shape_operator,
                                    simply_supported, solver, rtol, groups_of)
@@ -699,7 +713,8 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
                         boundary: str = "estimate",
                         boundary_normals: ArrayLike | None = None, boundary_shape_operator: ArrayLike | None = None,
                         simply_supported: ArrayLike | None = None, solver: str = "auto",
-                        rtol: float = DEFAULT_RTOL, feature_angle: float | None = None
+                        rtol: float = DEFAULT_RTOL, feature_angle: float | None = None,
+                        crease_edges: ArrayLike | None = None
                         ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
                                    list[int]]:
     """Drop-in replacement for ``igl.principal_curvature`` (libigl ≥ 2.5.4 / 2.6).
@@ -742,6 +757,12 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
         the crease's own line measure θ_e ℓ_e are in the richer
         :func:`igl_hhj.features.feature_principal_curvature`.  Only with
         ``boundary="estimate"`` and without boundary data.
+    crease_edges : (k, 2) array_like of int, optional (keyword-only)
+        Creases named by their vertex pairs (either order), cut in addition to those of
+        ``feature_angle`` (alone when ``feature_angle`` is None), e.g. the sharp edges a
+        CAD exporter marks (:func:`igl_hhj.features.crease_edges`).  Not with a mesh that
+        needs repair (its vertices are renumbered): repair it first
+        (:func:`igl_hhj.repair.repair_mesh`).
 
     Returns
     -------
@@ -781,7 +802,8 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
     1.0
     """
     check_principal_curvature_args(radius, useKring)
-    if feature_angle is None and boundary_normals is None and boundary_shape_operator is None \
+    if feature_angle is None and crease_edges is None and boundary_normals is None \
+            and boundary_shape_operator is None \
             and simply_supported is None and isinstance(solver, str) and solver in ("auto", "direct") \
             and isinstance(boundary, str) and boundary in BOUNDARY_TREATMENTS:
         # a small clean mesh: the same values in one compiled call (igl_hhj.small_mesh)
@@ -795,10 +817,12 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
         kw = dict(boundary=boundary, boundary_normals=boundary_normals,
                   boundary_shape_operator=boundary_shape_operator, simply_supported=simply_supported,
                   solver=solver, rtol=rtol, feature_angle=feature_angle)
+        _no_named_creases_on_repair(crease_edges, exc)
         return repaired_principal_curvature(principal_curvature, exc, V, F, radius, useKring, kw)
-    if feature_angle is not None:
+    if feature_angle is not None or crease_edges is not None:
         from .features import _feature_dropin
-        return _feature_dropin(mesh, None, radius, feature_angle=feature_angle, boundary=boundary,
+        return _feature_dropin(mesh, None, radius, feature_angle=feature_angle, crease_edges=crease_edges,
+                               boundary=boundary,
                               solver=solver, rtol=rtol,
                               data=(boundary_normals, boundary_shape_operator, simply_supported))
     return dropin_on_mesh(mesh, radius, boundary, boundary_normals, boundary_shape_operator,

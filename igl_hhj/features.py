@@ -431,13 +431,13 @@ def _side_values(V, F, radius, feature_angle, crease_edges, boundary, solver, rt
 
 
 def _feature_dropin(V: Any, F: ArrayLike | None, radius: int, *, feature_angle: float | None,
-                   boundary: str = "estimate", solver: str = "auto", rtol: float | None = None,
+                   crease_edges: ArrayLike | None = None, boundary: str = "estimate", solver: str = "auto", rtol: float | None = None,
                    data=()) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
                                      NDArray[np.float64], list[int]]:
     """``principal_curvature(..., feature_angle=...)``: the primary sides' values only
     (:func:`feature_principal_curvature` without the crease network)."""
     mesh, _, _, _, (PD1, PD2, PV1, PV2, bad) = _side_values(
-        V, F, radius, feature_angle, None, boundary, solver, rtol, data)
+        V, F, radius, feature_angle, crease_edges, boundary, solver, rtol, data)
     nV = mesh.n_vertices
     return (np.ascontiguousarray(PD1[:nV]), np.ascontiguousarray(PD2[:nV]),
             np.ascontiguousarray(PV1[:nV]), np.ascontiguousarray(PV2[:nV]), [b for b in bad if b < nV])

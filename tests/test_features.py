@@ -130,6 +130,32 @@ def test_shape_operator_with_features_is_flat_on_the_caps():
     assert np.abs(S_off[cap]).max() > scale                 # the rim's jump leaks into the caps
 
 
+def test_named_creases_in_the_dropin_and_shape_operator():
+    """crease_edges= names the creases: the capped cylinder's rims named by hand give the
+    bits of feature_angle=40 (which detects exactly them), in both public functions; named
+    creases on a mesh that needs repair are refused (a repair renumbers the vertices)."""
+    V, F, _ = capped_cylinder(2)
+    mesh = as_mesh(V, F)
+    rims = mesh.edges[ft.crease_edges(mesh, 40)]
+    assert len(rims) > 0
+    named = igl_hhj.principal_curvature(V, F, crease_edges=rims[:, ::-1])      # either order
+    detected = igl_hhj.principal_curvature(V, F, feature_angle=40)
+    for a, b in zip(named[:4], detected[:4]):
+        np.testing.assert_array_equal(a, b)
+    assert named[4] == detected[4]
+    np.testing.assert_array_equal(igl_hhj.shape_operator(V, F, crease_edges=rims),
+                                  igl_hhj.shape_operator(V, F, feature_angle=40))
+    half = igl_hhj.principal_curvature(V, F, crease_edges=rims[: len(rims) // 2])
+    assert not np.array_equal(half[2], detected[2])       # fewer creases: other values
+    Fd = np.vstack([F, F[:1]])                            # a duplicate face: repaired
+    with pytest.raises(ValueError, match="crease_edges cannot be used on a mesh that needs repair"):
+        igl_hhj.principal_curvature(V, Fd, crease_edges=rims)
+    with pytest.raises(ValueError, match="crease_edges cannot be used on a mesh that needs repair"):
+        igl_hhj.shape_operator(V, Fd, crease_edges=rims, repair=True)
+    with pytest.raises(ValueError, match="crease_edges"):
+        igl_hhj.principal_curvature(V, F, crease_edges=[[0, 10 ** 6]])
+
+
 def test_default_is_the_libigl_contract_bit_for_bit():
     """feature_angle=None is today's drop-in; on a smooth mesh (no crease above 40°) the
     cut is the mesh itself and features on give the same bits."""
