@@ -802,9 +802,9 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
     1.0
     """
     check_principal_curvature_args(radius, useKring)
-    if feature_angle is None and crease_edges is None and boundary_normals is None \
-            and boundary_shape_operator is None \
-            and simply_supported is None and isinstance(solver, str) and solver in ("auto", "direct") \
+    if all(x is None for x in (feature_angle, crease_edges, boundary_normals, boundary_shape_operator,
+                               simply_supported)) \
+            and isinstance(solver, str) and solver in ("auto", "direct") \
             and isinstance(boundary, str) and boundary in BOUNDARY_TREATMENTS:
         # a small clean mesh: the same values in one compiled call (igl_hhj.small_mesh)
         out = _small_mesh.try_dropin(V, F, radius, _check_rtol(rtol), boundary)
@@ -822,9 +822,8 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
     if feature_angle is not None or crease_edges is not None:
         from .features import _feature_dropin
         return _feature_dropin(mesh, None, radius, feature_angle=feature_angle, crease_edges=crease_edges,
-                               boundary=boundary,
-                              solver=solver, rtol=rtol,
-                              data=(boundary_normals, boundary_shape_operator, simply_supported))
+                               boundary=boundary, solver=solver, rtol=rtol,
+                               data=(boundary_normals, boundary_shape_operator, simply_supported))
     return dropin_on_mesh(mesh, radius, boundary, boundary_normals, boundary_shape_operator,
                           simply_supported, solver, rtol, release=True)
 

@@ -431,8 +431,8 @@ def _side_values(V, F, radius, feature_angle, crease_edges, boundary, solver, rt
 
 
 def _feature_dropin(V: Any, F: ArrayLike | None, radius: int, *, feature_angle: float | None,
-                   crease_edges: ArrayLike | None = None, boundary: str = "estimate", solver: str = "auto", rtol: float | None = None,
-                   data=()) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
+                   crease_edges: ArrayLike | None = None, boundary: str = "estimate", solver: str = "auto",
+                   rtol: float | None = None, data=()) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
                                      NDArray[np.float64], list[int]]:
     """``principal_curvature(..., feature_angle=...)``: the primary sides' values only
     (:func:`feature_principal_curvature` without the crease network)."""

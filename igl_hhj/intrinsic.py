@@ -65,6 +65,9 @@ ADAPTIVE_GAIN = 0.3
 ADAPTIVE_POWER = 0.25
 ADAPTIVE_RANGE = (0.2, 5.0)
 """Bounds of the factor ``a`` of :func:`adaptive_radius` (radius 5: 1 to 25 rings)."""
+SMOOTHING_MAXITER = 500
+"""Iteration cap of each smoothing solve of :func:`vertex_stage` (a solve that reaches it
+sends the vertex stage to the direct reference)."""
 PILOT_RADIUS = 5
 """Radius of the pilot smoothing (one implicit step) whose curvature sets the scale."""
 
@@ -355,7 +358,8 @@ def smoothing_rtol(rtol):
     return min(1e-3, float(np.sqrt(rtol)))
 
 
-def adaptive_smoothing(mesh: TriangleMesh, X, C0, mass, phase, rough, radius, rtol, maxiter=500):
+def adaptive_smoothing(mesh: TriangleMesh, X, C0, mass, phase, rough, radius, rtol,
+                       maxiter=SMOOTHING_MAXITER):
     """The smoothing of :func:`vertex_stage` with this module's parameters, in place on
     ``X`` (#V, 3): one compiled call (:func:`igl_hhj.kernels.intrinsic_smoothing`: pilot step,
     adaptive per-face radius, twiced smoothing), every solve to :func:`smoothing_rtol` of
@@ -373,7 +377,7 @@ def adaptive_smoothing(mesh: TriangleMesh, X, C0, mass, phase, rough, radius, rt
         steps=SMOOTHING_STEPS, coefficients=_kernel_coefficients(SMOOTHING_ORDER), rtol=srtol, maxiter=maxiter)
 
 
-def vertex_stage(mesh: TriangleMesh, S, radius, *, rtol=None, maxiter=500, info=None):
+def vertex_stage(mesh: TriangleMesh, S, radius, *, rtol=None, maxiter=SMOOTHING_MAXITER, info=None):
     """The drop-in's vertex stage, compiled: intrinsic patch recovery + twiced smoothing.
 
     Parameters

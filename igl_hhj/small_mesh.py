@@ -58,7 +58,7 @@ def _params():
                      int(it.SMOOTHING_STEPS))
         binom = [float(c) for c in _kernel_coefficients(it.SMOOTHING_ORDER)]
         area = igl.PerVertexNormalsWeightingType.PER_VERTEX_NORMALS_WEIGHTING_TYPE_AREA
-        _PARAMS = (checks, smoothing, binom, it.smoothing_rtol, COORDINATE_MAX, area)
+        _PARAMS = (checks, smoothing, binom, it.smoothing_rtol, it.SMOOTHING_MAXITER, COORDINATE_MAX, area)
     return _PARAMS
 
 
@@ -76,13 +76,14 @@ def try_dropin(V, F, radius, rtol, boundary="estimate"):
     Returns
     -------
     ``(PD1, PD2, PV1, PV2, bad_vertices)`` as :func:`igl_hhj.principal_curvature`, or
-    None when the mesh is not a small clean closed mesh (the general path must run).
+    None when the mesh is not a small clean mesh or the options are not the defaults
+    (the general path must run).
     """
     if type(V) is not np.ndarray or type(F) is not np.ndarray or V.ndim != 2 or F.ndim != 2 \
             or V.shape[1] != 3 or F.shape[1] != 3 or not 0 < 3 * F.shape[0] <= 2 * MAX_EDGES \
             or V.shape[0] == 0 or F.dtype.kind not in "iu" or V.dtype.kind != "f":
         return None
-    checks, smoothing, binom, smoothing_rtol, coordinate_max, area = _params()
+    checks, smoothing, binom, smoothing_rtol, maxiter, coordinate_max, area = _params()
     V = np.ascontiguousarray(V, dtype=np.float64)
     F = np.ascontiguousarray(F, dtype=np.int64)
     # the general path's coordinate and index checks (NaN fails the comparison), before
@@ -96,8 +97,8 @@ def try_dropin(V, F, radius, rtol, boundary="estimate"):
     cot = igl.cotmatrix_entries(V, F)
     status, PD1, PD2, PV1, PV2, bad = _hhj_core.dropin_small(
         V, F, np.ascontiguousarray(N, dtype=np.float64), np.ascontiguousarray(cot, dtype=np.float64),
-        checks[boundary], (float(radius), smoothing[0], smoothing[1], smoothing_rtol(rtol), *smoothing[2:], 500),
-        binom)
+        checks[boundary],
+        (float(radius), smoothing[0], smoothing[1], smoothing_rtol(rtol), *smoothing[2:], int(maxiter)), binom)
     if status != 0:
         return None
     return PD1, PD2, PV1, PV2, np.flatnonzero(bad).tolist()

@@ -103,7 +103,7 @@ int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0
     std::vector<unsigned char> folded(nV, 0);
     for (i64 v = 0; v < nV; ++v) {
         const double* sv = &s[3 * v];
-        folded[v] = ref[v] && std::sqrt(sv[0] * sv[0] + sv[1] * sv[1] + sv[2] * sv[2]) <= p.folded_rtol * asum[v];
+        folded[v] = ref[v] && std::sqrt(dot3(sv, sv)) <= p.folded_rtol * asum[v];
         if (!ref[v] || folded[v])
             for (int a = 0; a < 3; ++a) N[3 * v + a] = NAN;
     }
@@ -120,10 +120,11 @@ int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0
     }
     if (nb > 0) {
         const i64 n = (i64)bverts.size();
-        std::vector<double> N0((size_t)n * 3), Nfit((size_t)n * 3);
+        std::vector<double> Nstart((size_t)n * 3), Nfit((size_t)n * 3);
         for (i64 q = 0; q < n; ++q)
-            for (int a = 0; a < 3; ++a) N0[3 * q + a] = N[3 * bverts[q] + a];
-        boundary_normal_fits(V, nV, T.edges.data(), nE, bverts.data(), n, p.fit_rings, N0.data(), Nfit.data(), 1);
+            for (int a = 0; a < 3; ++a) Nstart[3 * q + a] = N[3 * bverts[q] + a];
+        boundary_normal_fits(V, nV, T.edges.data(), nE, bverts.data(), n, p.fit_rings, Nstart.data(), Nfit.data(),
+                             1);
         std::vector<double> fn((size_t)nb * 3), full((size_t)nV * 3, 0.0);
         for (i64 q = 0; q < nb; ++q)
             for (int a = 0; a < 3; ++a) fn[3 * q + a] = cross[3 * bface[q] + a] / dbl[bface[q]];
@@ -133,34 +134,26 @@ int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0
         Nb.assign((size_t)nV * 3, NAN);
         for (i64 q = 0; q < n; ++q)
             for (int a = 0; a < 3; ++a) Nb[3 * bverts[q] + a] = Nfit[3 * q + a];
-        auto side = [&](i64 v, i64 q) {          // (a0 b0 + a1 b1) + a2 b2 > SIDE_DOT_MIN
-            const double* x = &Nb[3 * v];
-            const double* y = &fn[3 * q];
-            double d = x[0] * y[0];
-            d += x[1] * y[1];
-            d += x[2] * y[2];
-            return d > p.side_dot_min;
-        };
+        // flag[v]: the normal of end `col` of one of v's boundary edges fails N·ν_T > SIDE_DOT_MIN
         std::vector<unsigned char> flag(nV);
-        for (int col = 0; col < 2; ++col) {     // the faces' mean normal where the fit looks away
+        auto looking_away = [&](int col) {
             std::fill(flag.begin(), flag.end(), 0);
             for (i64 q = 0; q < nb; ++q) {
                 const i64 v = T.edges[2 * bnd_edges[q] + col];
-                if (!side(v, q)) flag[v] = 1;
+                if (!(dot3(&Nb[3 * v], &fn[3 * q]) > p.side_dot_min)) flag[v] = 1;
             }
+        };
+        for (int col = 0; col < 2; ++col) {     // the faces' mean normal where the fit looks away
+            looking_away(col);
             for (i64 v = 0; v < nV; ++v)
                 if (flag[v]) {
                     const double* f = &full[3 * v];
-                    const double nf = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+                    const double nf = std::sqrt(dot3(f, f));
                     for (int a = 0; a < 3; ++a) Nb[3 * v + a] = f[a] / nf;
                 }
         }
         for (int col = 0; col < 2; ++col) {     // no normal where even that looks away
-            std::fill(flag.begin(), flag.end(), 0);
-            for (i64 q = 0; q < nb; ++q) {
-                const i64 v = T.edges[2 * bnd_edges[q] + col];
-                if (!side(v, q)) flag[v] = 1;
-            }
+            looking_away(col);
             for (i64 v = 0; v < nV; ++v)
                 if (flag[v])
                     for (int a = 0; a < 3; ++a) Nb[3 * v + a] = NAN;
@@ -177,7 +170,7 @@ int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0
         for (i64 v = 0; v < nV; ++v)            // normalised on the clamped edges' vertices
             if (flag[v]) {
                 double* x = &Nb[3 * v];
-                const double nn = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+                const double nn = std::sqrt(dot3(x, x));
                 if (nn < 1e-12) return SMALL_DEFECT;
                 for (int a = 0; a < 3; ++a) x[a] /= nn;
             }
@@ -205,7 +198,7 @@ int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0
         const double* a = V + 3 * T.edges[2 * e];
         const double* b = V + 3 * T.edges[2 * e + 1];
         const double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-        len[e] = std::sqrt((d[0] * d[0] + d[1] * d[1]) + d[2] * d[2]);
+        len[e] = std::sqrt(dot3(d, d));          // (d0² + d1²) + d2², as mesh.unique_edge_lengths
     }
     for (i64 q = 0; q < nb; ++q) {
         const i64 e = bnd_edges[q];
@@ -217,7 +210,7 @@ int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0
         const double* x1 = V + 3 * F[3 * f + (i + 1) % 3];
         const double* x2 = V + 3 * F[3 * f + (i + 2) % 3];
         double t[3] = {x2[0] - x1[0], x2[1] - x1[1], x2[2] - x1[2]};
-        const double tl = std::sqrt((t[0] * t[0] + t[1] * t[1]) + t[2] * t[2]);
+        const double tl = std::sqrt(dot3(t, t));
         for (int a = 0; a < 3; ++a) t[a] /= tl;
         double nu[3], cn[3];
         for (int a = 0; a < 3; ++a) nu[a] = cross[3 * f + a] / dbl[f];
@@ -233,12 +226,7 @@ int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0
                 }
                 xi[k][a] = 0.5 * (pe[0] + pe[1]);
             }
-        for (int k = 0; k < 3; ++k) {
-            double g = cn[0] * xi[k][0];
-            g += cn[1] * xi[k][1];
-            g += cn[2] * xi[k][2];
-            row[k] += len[e] * g;
-        }
+        for (int k = 0; k < 3; ++k) row[k] += len[e] * dot3(cn, xi[k]);   // (n0 ξ0 + n1 ξ1) + n2 ξ2
     }
     for (i64 i = 0; i < nE; ++i)
         for (int k = 0; k < 3; ++k) R[3 * i + k] = load[3 * perm[i] + k];
@@ -277,18 +265,14 @@ int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0
         for (i64 f = 0; f < nF; ++f) {
             const double area = 0.5 * dbl[f];
             const double fac = area > 0 ? w[f] / area : 0.0;
-            const bool near = nb > 0 && (band[F[3 * f]] || band[F[3 * f + 1]] || band[F[3 * f + 2]]);
-            const double stiff = nb > 0 ? fac * (near ? p.band_factor * p.band_factor : 1.0) : fac;
+            const bool near = band[F[3 * f]] || band[F[3 * f + 1]] || band[F[3 * f + 2]];
+            const double stiff = fac * (near ? p.band_factor * p.band_factor : 1.0);   // fac · 1 = fac
+            const double share = w[f] * fac / 3.0;
             for (int c = 0; c < 3; ++c) {
                 const double x = cot[3 * f + c] * stiff;
                 C[3 * f + c] = std::isfinite(x) ? x : 0.0;
+                m[F[3 * f + c]] += share;
             }
-        }
-        for (i64 f = 0; f < nF; ++f) {
-            const double area = 0.5 * dbl[f];
-            const double fac = area > 0 ? w[f] / area : 0.0;
-            const double share = w[f] * fac / 3.0;
-            for (int c = 0; c < 3; ++c) m[F[3 * f + c]] += share;
         }
         double mmax = m[0];
         for (i64 v = 1; v < nV; ++v) mmax = m[v] > mmax ? m[v] : mmax;
