@@ -1,5 +1,6 @@
 """The speed benchmark runs (on its quick meshes) and reports what it measured."""
 import numpy as np
+import pytest
 
 from igl_hhj.benchmarks import speed
 
@@ -58,3 +59,16 @@ def test_tiny_study_reports_every_tiny_mesh():
     assert all(r["faces"] <= 1280 and r["libigl_ms"] > 0 and r["hhj_ms"] > 0 for r in rows)
     assert all(abs(r["ratio"] - r["hhj_ms"] / r["libigl_ms"]) < 1e-12 for r in rows)
     assert "target ≤ 2" in speed.tiny_markdown(rows)
+
+
+def test_feature_study_reports_the_feature_meshes():
+    """--features: the cost of feature_angle=40 against the plain drop-in on the shared
+    fandisk (skipped without the shared meshes), CPU times on one thread."""
+    from conftest import MESH_DIR
+    if not (MESH_DIR / "fandisk.off").is_file():
+        pytest.skip("shared meshes not found")
+    rows = speed.feature_study(mesh_dir=MESH_DIR, calls=1)
+    assert [r["mesh"] for r in rows] == ["fandisk.off"]
+    assert all(r["plain_ms"] > 0 and r["features_ms"] > 0 for r in rows)
+    assert all(abs(r["ratio"] - r["features_ms"] / r["plain_ms"]) < 1e-12 for r in rows)
+    assert "target ≤ 1.3" in speed.feature_markdown(rows)

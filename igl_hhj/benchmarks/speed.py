@@ -2,7 +2,8 @@
 measured in the same run.
 
     python -m igl_hhj.benchmarks.speed [--quick] [--repeat 3] [--meshes DIR] [--out DIR]
-    python -m igl_hhj.benchmarks.speed --rtol-study | --sliver-study | --factor-study | --tiny | --profile 'icosphere(8)'
+    python -m igl_hhj.benchmarks.speed --rtol-study | --sliver-study | --factor-study | --tiny | --features \
+        | --profile 'icosphere(8)'
 
 Meshes: icosphere(7) (328k faces) and icosphere(8) (1.31M), a jittered ellipsoid at
 82k / 328k / 1.31M faces (linear-scaling check), Walker's torus from a perturbed grid
@@ -545,6 +546,59 @@ def tiny_markdown(rows):
     return "\n".join(lines)
 
 
+FEATURE_MESHES = ("fandisk.off", "screwdriver.off")
+"""The meshes of :func:`feature_study` (those present in the mesh folder)."""
+
+
+def feature_study(mesh_dir=None, calls=15, feature_angle=40):
+    """Cost of sharp-feature handling (issue 27: ≤ 1.3× the drop-in without it).
+
+    For each of :data:`FEATURE_MESHES` found in ``mesh_dir`` (default ../shared/data/meshes):
+    the median CPU time (``time.process_time``, one thread) over ``calls`` interleaved
+    calls of ``igl_hhj.principal_curvature(V, F)`` and ``(V, F, feature_angle=...)``, after
+    three warm-up calls of each.  Returns rows ``{mesh, faces, plain_ms, features_ms,
+    ratio}``."""
+    import igl
+
+    import igl_hhj
+    from .. import kernels
+    mesh_dir = _default_mesh_dir() if mesh_dir is None else Path(mesh_dir)
+    rows = []
+    if mesh_dir is None:
+        return rows
+    nt = kernels.max_threads()
+    kernels.set_num_threads(1)
+    try:
+        for name in FEATURE_MESHES:
+            path = mesh_dir / name
+            if not path.is_file():
+                continue
+            V, F = igl.read_triangle_mesh(str(path))
+            calls_ = (lambda: igl_hhj.principal_curvature(V, F),
+                      lambda: igl_hhj.principal_curvature(V, F, feature_angle=feature_angle))
+            for _ in range(3):
+                for f in calls_:
+                    f()
+            t = np.empty((calls, 2))
+            for k in range(calls):
+                for j, f in enumerate(calls_):
+                    t0 = time.process_time()
+                    f()
+                    t[k, j] = time.process_time() - t0
+            a, b = np.median(t, axis=0) * 1e3
+            rows.append({"mesh": name, "faces": len(F), "plain_ms": a, "features_ms": b, "ratio": b / a})
+    finally:
+        kernels.set_num_threads(nt)
+    return rows
+
+
+def feature_markdown(rows):
+    lines = ["| mesh | faces | drop-in ms | with features ms | ratio (target ≤ 1.3) |", "|---|---|---|---|---|"]
+    lines += [f"| {r['mesh']} | {r['faces']:,} | {r['plain_ms']:.1f} | {r['features_ms']:.1f} | {r['ratio']:.2f} |"
+              for r in rows]
+    return "\n".join(lines)
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--quick", action="store_true", help="three small meshes (seconds)")
@@ -567,7 +621,12 @@ def main(argv=None):
                    help="only the tolerance study (PCG iterations and error vs rtol)")
     p.add_argument("--tiny", action="store_true",
                    help="only the fixed cost per call on meshes under 1,000 faces (median of interleaved calls)")
+    p.add_argument("--features", action="store_true",
+                   help="only the cost of feature_angle=40 against the plain drop-in (fandisk, screwdriver)")
     a = p.parse_args(argv)
+    if a.features:
+        print(feature_markdown(feature_study(mesh_dir=a.meshes)))
+        return
     if a.tiny:
         print(tiny_markdown(tiny_study()))
         return
