@@ -513,6 +513,21 @@ def _octahedron():
     return V, F
 
 
+def _interleaved_ms(fns, calls, warmup, clock):
+    """Median milliseconds of each of ``fns`` over ``calls`` interleaved rounds (f0, f1, …,
+    f0, f1, …) after ``warmup`` rounds, timed with ``clock`` (a ``time`` function)."""
+    for _ in range(warmup):
+        for f in fns:
+            f()
+    t = np.empty((calls, len(fns)))
+    for k in range(calls):
+        for j, f in enumerate(fns):
+            t0 = clock()
+            f()
+            t[k, j] = clock() - t0
+    return np.median(t, axis=0) * 1e3
+
+
 def tiny_study(calls=400):
     """Fixed cost per call on meshes under 1,000 faces (issue 24: ≤ 2× libigl's time).
 
@@ -525,16 +540,8 @@ def tiny_study(calls=400):
     import igl_hhj
     rows = []
     for name, V, F in tiny_meshes():
-        for _ in range(20):
-            igl.principal_curvature(V, F)
-            igl_hhj.principal_curvature(V, F)
-        t = np.empty((calls, 2))
-        for k in range(calls):
-            for j, f in enumerate((igl.principal_curvature, igl_hhj.principal_curvature)):
-                t0 = time.perf_counter()
-                f(V, F)
-                t[k, j] = time.perf_counter() - t0
-        a, b = np.median(t, axis=0) * 1e3
+        a, b = _interleaved_ms((lambda: igl.principal_curvature(V, F), lambda: igl_hhj.principal_curvature(V, F)),
+                               calls, warmup=20, clock=time.perf_counter)
         rows.append({"mesh": name, "faces": len(F), "libigl_ms": a, "hhj_ms": b, "ratio": b / a})
     return rows
 
@@ -574,18 +581,9 @@ def feature_study(mesh_dir=None, calls=15, feature_angle=40):
             if not path.is_file():
                 continue
             V, F = igl.read_triangle_mesh(str(path))
-            calls_ = (lambda: igl_hhj.principal_curvature(V, F),
-                      lambda: igl_hhj.principal_curvature(V, F, feature_angle=feature_angle))
-            for _ in range(3):
-                for f in calls_:
-                    f()
-            t = np.empty((calls, 2))
-            for k in range(calls):
-                for j, f in enumerate(calls_):
-                    t0 = time.process_time()
-                    f()
-                    t[k, j] = time.process_time() - t0
-            a, b = np.median(t, axis=0) * 1e3
+            a, b = _interleaved_ms((lambda: igl_hhj.principal_curvature(V, F),
+                                    lambda: igl_hhj.principal_curvature(V, F, feature_angle=feature_angle)),
+                                   calls, warmup=3, clock=time.process_time)
             rows.append({"mesh": name, "faces": len(F), "plain_ms": a, "features_ms": b, "ratio": b / a})
     finally:
         kernels.set_num_threads(nt)
