@@ -539,6 +539,7 @@ def adaptive_radius(mesh, pilot, rough, radius, gain, power, lo, hi):
     rough = _f64(rough, "rough")
     if pilot.shape[0] != mesh.n_vertices or rough.shape != (mesh.n_vertices,):
         raise ValueError("adaptive_radius: pilot must be (#V, 3) and rough (#V,)")
+    _threads()
     return _core.adaptive_radius(mesh.V, mesh.F, pilot, rough, float(radius), float(gain), float(power),
                                  float(lo), float(hi))
 

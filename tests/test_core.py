@@ -324,6 +324,81 @@ def test_recovery_kernels_equal_reference(closed):
     np.testing.assert_allclose(l2max, (ev ** 2).sum(axis=2).max(axis=1), rtol=1e-15)
 
 
+def test_patch_fit_of_vertices_whose_faces_all_weigh_zero(closed):
+    """The compiled patch fit gathers each vertex's corners; a vertex whose corners all weigh 0
+    falls back to the plain average of its faces (weight 1 each) there too: the compiled
+    recoveries equal the numpy references on a mesh with such vertices."""
+    from igl_hhj import intrinsic
+    from igl_hhj import recovery as rc
+    S = _shape_operator(closed, None, None, None, "direct")
+    N = closed.vertex_normals
+    w = kernels.recovery_weights(closed, rc.QUALITY_FLOOR)
+    lost = np.arange(0, closed.n_vertices, 37)
+    w[np.isin(closed.F, lost).any(axis=1)] = 0.0
+    assert (np.bincount(closed.F.ravel(), np.repeat(w, 3), closed.n_vertices)[lost] == 0).all()
+    X = kernels.patch_recovery(closed, S, N, w)
+    Sv, _ = rc.recover_vertex_tensors(closed, S, weights=w)
+    assert rel(rc._from6(X), Sv) <= 1e-13
+    Xi, rough = kernels.intrinsic_patch_recovery(closed, S, N, w)
+    assert rel(Xi, intrinsic.recover(closed, S, N, w)) <= 1e-13
+    assert rel(rough, intrinsic.roughness(closed, S, N, Xi, w)) <= 1e-13
+    assert np.isfinite(Xi).all() and np.abs(Xi[lost]).max() > 0
+
+
+def test_gathered_vertex_kernels_bit_identical_across_thread_counts():
+    """The recovery and the adaptive radius gather every vertex's corners in face order, in
+    parallel over vertices: one and two threads give the same bits (>= 20k vertices, where
+    the kernels take two)."""
+    from igl_hhj import recovery as rc
+    m = TriangleMesh(*icosphere(6))
+    S = _shape_operator(m, None, None, None, "cg", 1e-10)
+    N = m.vertex_normals
+    w = kernels.recovery_weights(m, rc.QUALITY_FLOOR)
+    P = np.random.default_rng(1).normal(size=(m.n_vertices, 3))
+    nt = kernels.max_threads()
+    adapt, kernels.ADAPT_TO_LOAD = kernels.ADAPT_TO_LOAD, False
+    out = []
+    try:
+        for k in (1, max(2, nt)):
+            kernels.set_num_threads(k)
+            Xi, rough = kernels.intrinsic_patch_recovery(m, S, N, w)
+            out.append((kernels.patch_recovery(m, S, N, w), Xi, rough,
+                        kernels.adaptive_radius(m, P, rough, 5.0, 0.3, 0.25, 0.2, 5.0)))
+    finally:
+        kernels.set_num_threads(nt)
+        kernels.ADAPT_TO_LOAD = adapt
+    for a, b in zip(*out):
+        assert np.array_equal(a, b)
+
+
+def test_smoothing_with_edges_out_of_lexicographic_order(closed):
+    """The compiled smoothing sums each diagonal row by row when the edges are listed in
+    lexicographic order (TriangleMesh.edges); any other order takes the serial scatter,
+    which must give the same smoothing (to round-off: the rows list their entries in
+    another order)."""
+    import types
+    from igl_hhj import intrinsic
+    from igl_hhj import recovery as rc
+    S = _shape_operator(closed, None, None, None, "direct")
+    N = closed.vertex_normals
+    w = kernels.recovery_weights(closed, rc.QUALITY_FLOOR)
+    X0, rough = kernels.intrinsic_patch_recovery(closed, S, N, w)
+    C0, mass = rc.smoothing_coefficients(closed, w)
+    phase = kernels.transport_phases(closed, N)
+    perm = np.random.default_rng(3).permutation(closed.n_edges)
+    shuffled = types.SimpleNamespace(
+        V=closed.V, F=closed.F, n_vertices=closed.n_vertices, n_faces=closed.n_faces, n_edges=closed.n_edges,
+        edges=closed.edges[perm], edge_faces=closed.edge_faces[perm],
+        edge_local_index=closed.edge_local_index[perm])
+    out = []
+    for mesh, ph in ((closed, phase), (shuffled, phase[perm])):
+        X = X0.copy()
+        status, its, _, r = intrinsic.adaptive_smoothing(mesh, X, C0, mass, ph, rough, 5, 1e-12)
+        assert status == 0 and its > 0
+        out.append((X, r))
+    assert rel(out[1][0], out[0][0]) <= 1e-9 and rel(out[1][1], out[0][1]) <= 1e-12
+
+
 def test_smoothing_falls_back_to_the_reference_when_a_solve_stalls(closed, monkeypatch):
     from igl_hhj import recovery as rc
     S = _shape_operator(closed, None, None, None, "direct")

@@ -348,7 +348,7 @@ NB_MODULE(_hhj_core, m) {
             nb::gil_scoped_release nogil;
             hhj::ThreadBudget tb(nV);
             hhj::patch_recovery(V.data(), F.data(), nF, nV, S.data(), N.data(), w.data(), ref.data(), h,
-                                X.data());
+                                X.data(), tb.nt);
             hhj::tangent_projection6(X.data(), N.data(), ref.data(), nV, keep_trace, tb.nt);
         }
         return to_numpy(std::move(X), {(size_t)nV, 6});
@@ -452,8 +452,9 @@ NB_MODULE(_hhj_core, m) {
         std::vector<double> r(nF);
         {
             nb::gil_scoped_release nogil;
+            hhj::ThreadBudget tb(nF);
             hhj::adaptive_radius(V.data(), F.data(), nF, nV, P.data(), rough.data(), radius, gain, power, lo, hi,
-                                 r.data());
+                                 r.data(), tb.nt);
         }
         return to_numpy(std::move(r), {(size_t)nF});
     });

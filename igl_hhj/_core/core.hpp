@@ -52,6 +52,19 @@ constexpr i64 CHUNK = 2048;
 // 20k unknowns (cheburashka), 8 % slower at 34k (camelhead), 1.5x faster at 123k).
 constexpr i64 PCG_MIN_WORK = 200000;
 
+// The corners of every vertex in face order (a counting sort of F): corners of v are
+// corner[start[v] .. start[v + 1]), each f * 3 + c.  Sums over a vertex's corners in this
+// order are the sums a scatter over the faces makes, bit for bit.
+struct VertexCorners {
+    std::vector<i64> start, corner;
+    VertexCorners(const i64* F, i64 nF, i64 nV) : start(nV + 1, 0), corner((size_t)nF * 3) {
+        for (i64 q = 0; q < 3 * nF; ++q) ++start[F[q] + 1];
+        for (i64 v = 0; v < nV; ++v) start[v + 1] += start[v];
+        std::vector<i64> next(start.begin(), start.end() - 1);
+        for (i64 q = 0; q < 3 * nF; ++q) corner[next[F[q]]++] = q;
+    }
+};
+
 // ------------------------------------------------------------------ geometry
 struct FaceGeom {
     double t[3][3];   // unit edge vectors t_i
@@ -193,7 +206,7 @@ void principal_2x2(const double* S, const double* N, i64 n, double* PD1, double*
 void recovery_weights(const double* V, const i64* F, i64 nF, const i64* FE, const i64* EF, i64 nE,
                       double floor, double* w, int nt);
 void patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S, const double* N,
-                    const double* w, const unsigned char* ref, double h, double* X);
+                    const double* w, const unsigned char* ref, double h, double* X, int nt);
 void tangent_projection6(double* X, const double* N, const unsigned char* ref, i64 n, bool keep_trace,
                          int nt);
 void intrinsic_patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S,
@@ -211,7 +224,7 @@ void boundary_normal_fits(const double* X, i64 nV, const i64* E, i64 nE, const i
 i64 vertex_groups(i64 nV, const i64* E, i64 nE, std::vector<std::int32_t>& label);
 void transport_phases(const double* N, i64 nV, const i64* E, i64 nE, double* phase, int nt);
 void adaptive_radius(const double* V, const i64* F, i64 nF, i64 nV, const double* P, const double* rough,
-                     double radius, double gain, double power, double lo, double hi, double* r);
+                     double radius, double gain, double power, double lo, double hi, double* r, int nt);
 void face_times(const double* V, const i64* F, i64 nF, const double* r, int r_stride, double factor,
                 int steps, double* t, int nt);
 void principal_hz(const double* X, const double* N, i64 n, double* PD1, double* PD2, double* PV1,

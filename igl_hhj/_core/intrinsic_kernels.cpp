@@ -107,17 +107,27 @@ void reduce_rows(i64 n, const std::int32_t* group, i64 ng, int nt, std::vector<d
 // Solve A x = b (x0 = 0), Jacobi-preconditioned, CG scalars per (group, part), three fused
 // sweeps per iteration (A p with p.Ap; the update of x and r with r.r and r.(D^-1 r); p).
 // Returns 0 converged, 1 iteration cap, 3 breakdown (non-positive curvature).
+// r, p, q: work vectors of n x 3 (reused across solves: no fresh pages per solve).
 int pcg_hz(const HZSystem& S, const std::int32_t* group, i64 ng, const double* b, double* x,
-           double rtol, i64 maxiter, int nt, i64* its) {
+           double rtol, i64 maxiter, int nt, i64* its, std::vector<double>& r, std::vector<double>& p,
+           std::vector<double>& q) {
     const i64 n = S.n;
     const size_t n3 = (size_t)n * 3;
     const size_t np = (size_t)ng * 2;
     const int th = nt;      // reduce_rows: the same bits for any thread count, one group or several
-    std::vector<double> r(b, b + n3), p(n3), q(n3), red;
+    r.resize(n3); p.resize(n3); q.resize(n3);
+    std::vector<double> red;
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(th)
+#endif
+    for (i64 k = 0; k < (i64)n3; ++k) r[k] = b[k];
     std::vector<double> bb(np), rz(np), alpha(np), beta(np);
     std::vector<unsigned char> done(np, 0);
     auto gid = [&](i64 row) { return ng == 1 ? (i64)0 : (i64)group[row]; };
-    std::fill(x, x + n3, 0.0);
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(th)
+#endif
+    for (i64 k = 0; k < (i64)n3; ++k) x[k] = 0.0;
     // bb = b.b, rz = r.(D^-1 r), p = D^-1 r
     reduce_rows<2>(n, group, ng, th, red, [&](i64 i, double (&v)[2][2]) {
         const double d = S.dinv[i];
@@ -254,35 +264,56 @@ void transport_phases(const double* N, i64 nV, const i64* E, i64 nE, double* pha
 // a_v = clip(gain rho_v^power / max(c_v, 1e-3), lo, hi), rho and c the area-weighted
 // ring means of rough and of h_v (|h| + |z|) of the pilot P (#V,3); non-finite a -> 1.
 void adaptive_radius(const double* V, const i64* F, i64 nF, i64 nV, const double* P, const double* rough,
-                     double radius, double gain, double power, double lo, double hi, double* r) {
-    std::vector<double> hsum(nV, 0.0), cnt(nV, 0.0), area(nF), hT(nF);
+                     double radius, double gain, double power, double lo, double hi, double* r, int nt) {
+    // faces in parallel; the per-vertex sums gather v's corners in face order (the bits of
+    // a serial scatter over the faces, for any thread count)
+    const VertexCorners vc(F, nF, nV);
+    std::vector<double> area(nF), hT(nF);
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
     for (i64 f = 0; f < nF; ++f) {
         double l[3];
         area[f] = face_lengths(V, F, f, l);
-        const double h = (l[0] + l[1] + l[2]) / 3.0;
-        hT[f] = h;
-        for (int k = 0; k < 3; ++k) { hsum[F[3 * f + k]] += h; cnt[F[3 * f + k]] += 1.0; }
+        hT[f] = (l[0] + l[1] + l[2]) / 3.0;
     }
-    std::vector<double> cv(nV), num_c(nV, 0.0), num_r(nV, 0.0), den(nV, 0.0);
+    std::vector<double> cv(nV);
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
     for (i64 v = 0; v < nV; ++v) {
-        const double hv = hsum[v] / std::max(cnt[v], 1.0);
+        double hsum = 0.0, cnt = 0.0;
+        for (i64 q = vc.start[v]; q < vc.start[v + 1]; ++q) { hsum += hT[vc.corner[q] / 3]; cnt += 1.0; }
+        const double hv = hsum / std::max(cnt, 1.0);
         cv[v] = hv * (std::fabs(P[3 * v]) + std::hypot(P[3 * v + 1], P[3 * v + 2]));
     }
+    std::vector<double> mc(nF), mr(nF);
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
     for (i64 f = 0; f < nF; ++f) {
-        double mc = 0.0, mr = 0.0;
-        for (int k = 0; k < 3; ++k) { mc += cv[F[3 * f + k]] / 3.0; mr += rough[F[3 * f + k]] / 3.0; }
-        for (int k = 0; k < 3; ++k) {
-            const i64 v = F[3 * f + k];
-            num_c[v] += area[f] * mc; num_r[v] += area[f] * mr; den[v] += area[f];
-        }
+        double c = 0.0, rr = 0.0;
+        for (int k = 0; k < 3; ++k) { c += cv[F[3 * f + k]] / 3.0; rr += rough[F[3 * f + k]] / 3.0; }
+        mc[f] = c; mr[f] = rr;
     }
     std::vector<double> a(nV);
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
     for (i64 v = 0; v < nV; ++v) {
-        const double c = num_c[v] / den[v], rho = num_r[v] / den[v];
+        double num_c = 0.0, num_r = 0.0, den = 0.0;
+        for (i64 q = vc.start[v]; q < vc.start[v + 1]; ++q) {
+            const i64 f = vc.corner[q] / 3;
+            num_c += area[f] * mc[f]; num_r += area[f] * mr[f]; den += area[f];
+        }
+        const double c = num_c / den, rho = num_r / den;
         double x = gain * std::pow(rho, power) / std::max(c, 1e-3);
         x = std::isfinite(x) ? std::min(std::max(x, lo), hi) : 1.0;
         a[v] = x;
     }
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
     for (i64 f = 0; f < nF; ++f)
         r[f] = radius * (a[F[3 * f]] + a[F[3 * f + 1]] + a[F[3 * f + 2]]) / 3.0;
 }
@@ -346,12 +377,19 @@ struct HZProblem {
     const i64 *E = nullptr, *EF = nullptr, *ELI = nullptr;
     const double *C0 = nullptr, *m = nullptr;
     i64 nE = 0;
+    // E lists i < j in lexicographic order (TriangleMesh.edges): then every row of the
+    // matrix lists its entries in the order of the edges, and fill() may sum the diagonal
+    // row by row (in parallel) with the bits of the serial scatter over the edges
+    bool rows_in_edge_order = true;
+    std::vector<double> Y, R, AY, dY, acc, wr, wp, wq;    // work vectors of run()
 
     HZProblem(i64 nV, const i64* E_, i64 nE_, const i64* EF_, const i64* ELI_, const double* C0_,
               const double* m_, const double* phase)
         : E(E_), EF(EF_), ELI(ELI_), C0(C0_), m(m_), nE(nE_) {
         ngroups = vertex_groups(nV, E, nE, label);
         S.n = nV;
+        for (i64 e = 0; e < nE && rows_in_edge_order; ++e)
+            rows_in_edge_order = E[2 * e] < E[2 * e + 1] && (e == 0 || E[2 * e - 2] <= E[2 * e]);
         vertex_laplacian(nV, E, nE, EF, ELI, C0, S.indptr, S.indices, S.a, diag_pos, &pos_lo, &pos_hi);
         const size_t nnz = S.a.size();
         S.pc.assign(nnz, 1.0);
@@ -364,8 +402,35 @@ struct HZProblem {
         S.dinv.resize(nV);
     }
 
-    void fill(const double* t) {
+    void fill(const double* t, int nt) {
         const i64 nV = S.n;
+        if (rows_in_edge_order) {
+            // off-diagonal entries: one per (edge, end), distinct positions
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+            for (i64 e = 0; e < nE; ++e) {
+                double we = 0.0;
+                for (int s = 0; s < 2; ++s) {
+                    const i64 f = EF[2 * e + s];
+                    if (f >= 0) we += C0[3 * f + ELI[2 * e + s]] * t[f];
+                }
+                S.a[pos_lo[e]] = -we;
+                S.a[pos_hi[e]] = -we;
+            }
+            // diagonal m_v + sum of the row's w_e, in the row's (= the edges') order
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+            for (i64 v = 0; v < nV; ++v) {
+                double d = m[v];
+                for (i64 q = S.indptr[v]; q < S.indptr[v + 1]; ++q)
+                    if (q != diag_pos[v]) d += -S.a[q];
+                S.a[diag_pos[v]] = d;
+                S.dinv[v] = 1.0 / d;
+            }
+            return;
+        }
         for (i64 v = 0; v < nV; ++v) S.a[diag_pos[v]] = m[v];
         for (i64 e = 0; e < nE; ++e) {
             double we = 0.0;
@@ -384,19 +449,34 @@ struct HZProblem {
     // X <- (I - (I - G)^order) X, G = `steps` implicit steps; X unchanged on failure
     int run(double* X, int steps, const std::vector<double>& binom, double rtol, i64 maxiter, int nt,
             i64* iterations) {
-        const size_t n3 = (size_t)S.n * 3;
-        std::vector<double> Y(X, X + n3), R(n3), AY(n3), dY(n3), acc(n3, 0.0);
+        const i64 n3 = S.n * 3;
+        for (auto* v : {&Y, &R, &AY, &dY, &acc}) v->resize((size_t)n3);
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+        for (i64 q = 0; q < n3; ++q) { Y[q] = X[q]; acc[q] = 0.0; }
         for (size_t j = 0; j < binom.size(); ++j) {
             for (int st = 0; st < steps; ++st) {
                 apply(S, Y.data(), AY.data(), nt);
-                for (size_t q = 0; q < n3; ++q) R[q] = m[q / 3] * Y[q] - AY[q];
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+                for (i64 q = 0; q < n3; ++q) R[q] = m[q / 3] * Y[q] - AY[q];
                 i64 its = 0;
-                const int status = pcg_hz(S, label.data(), ngroups, R.data(), dY.data(), rtol, maxiter, nt, &its);
+                const int status = pcg_hz(S, label.data(), ngroups, R.data(), dY.data(), rtol, maxiter, nt, &its,
+                                          wr, wp, wq);
                 *iterations += its;
                 if (status != 0) return status;
-                for (size_t q = 0; q < n3; ++q) Y[q] += std::isfinite(dY[q]) ? dY[q] : 0.0;
+                const double bj = binom[j];
+                const bool last = st + 1 == steps;
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt)
+#endif
+                for (i64 q = 0; q < n3; ++q) {
+                    Y[q] += std::isfinite(dY[q]) ? dY[q] : 0.0;
+                    if (last) acc[q] += bj * Y[q];
+                }
             }
-            for (size_t q = 0; q < n3; ++q) acc[q] += binom[j] * Y[q];
         }
         std::copy(acc.begin(), acc.end(), X);
         return 0;
@@ -420,13 +500,13 @@ int intrinsic_smoothing(const double* V, const i64* F, i64 nF, i64 nV, const i64
     *iterations = 0;
     std::vector<double> t(nF), pilot(X, X + (size_t)nV * 3);
     face_times(V, F, nF, &pilot_radius, 0, per_radius, 1, t.data(), nt);
-    P.fill(t.data());
+    P.fill(t.data(), nt);
     int status = P.run(pilot.data(), 1, {1.0}, pilot_rtol, maxiter, nt, iterations);
     if (status != 0) return status;
-    adaptive_radius(V, F, nF, nV, pilot.data(), rough, radius, gain, power, lo, hi, r);
+    adaptive_radius(V, F, nF, nV, pilot.data(), rough, radius, gain, power, lo, hi, r, nt);
     std::vector<double>().swap(pilot);
     face_times(V, F, nF, r, 1, per_radius, steps, t.data(), nt);
-    P.fill(t.data());
+    P.fill(t.data(), nt);
     return P.run(X, steps, binom, rtol, maxiter, nt, iterations);
 }
 

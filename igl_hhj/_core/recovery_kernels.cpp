@@ -69,103 +69,106 @@ void recovery_weights(const double* V, const i64* F, i64 nF, const i64* FE, cons
 // of a + b u + c v to the corner values at the centroid offsets (u, v) / h in v's
 // tangent frame, evaluated at the vertex; the lumped weight W / sum W where the linear
 // part is ill-conditioned.  cw(f, c) the corner weight (vertices whose corners all
-// weigh 0 get weight 1 on each), emit(f, c, v, k) receives every coefficient, in face
-// order (serial: deterministic).  N (#V,3) (non-finite entries count as 0), ref (#V,).
-template <class CornerWeight, class Emit>
+// weigh 0 get weight 1 on each), W = cw / (the largest corner weight).  Each vertex
+// gathers its corners in face order (VertexCorners) and calls emit(f, c, v, k) for them
+// in that order, then done(v): vertices run in parallel, emit and done may write v's
+// own outputs only, and every sum has the order of a serial scatter over the faces (the
+// same bits for any thread count).  N (#V,3) (non-finite entries count as 0), ref (#V,).
+template <class CornerWeight, class Emit, class Done>
 void patch_fit(const double* V, const i64* F, i64 nF, i64 nV, const double* N, const unsigned char* ref,
-               double h, CornerWeight cw, Emit emit) {
+               double h, const VertexCorners& vc, CornerWeight cw, Emit emit, Done done, int nt) {
+    // lost: referenced vertices whose corners all weigh 0 (plain average, weight 1 each);
+    // s0: the sum of the corner weights (of the 1s where lost)
     std::vector<double> s0(nV, 0.0);
-    for (i64 f = 0; f < nF; ++f)
-        for (int c = 0; c < 3; ++c) s0[F[3 * f + c]] += cw(f, c);
-    // vertices whose faces all have weight 0: plain average (weight 1 per face)
     std::vector<unsigned char> lost(nV, 0);
-    bool any_lost = false;
-    for (i64 v = 0; v < nV; ++v) {
-        lost[v] = ref[v] && !(s0[v] > 0);
-        any_lost = any_lost || lost[v];
-    }
-    auto corner_weight = [&](i64 f, int c) { return lost[F[3 * f + c]] ? 1.0 : cw(f, c); };
     double wmax = 0.0;
-    if (any_lost) std::fill(s0.begin(), s0.end(), 0.0);
-    for (i64 f = 0; f < nF; ++f)
-        for (int c = 0; c < 3; ++c) {
-            const double W = corner_weight(f, c);
-            if (any_lost) s0[F[3 * f + c]] += W;
-            wmax = std::max(wmax, W);
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel for schedule(static) num_threads(nt) reduction(max : wmax)
+#endif
+    for (i64 v = 0; v < nV; ++v) {
+        double sum = 0.0, mx = 0.0;
+        for (i64 q = vc.start[v]; q < vc.start[v + 1]; ++q) {
+            const double W = cw(vc.corner[q] / 3, (int)(vc.corner[q] % 3));
+            sum += W;
+            mx = std::max(mx, W);
         }
+        lost[v] = ref[v] && !(sum > 0);
+        if (lost[v]) {       // its corners weigh 1 each
+            sum = 0.0;
+            for (i64 q = vc.start[v]; q < vc.start[v + 1]; ++q) sum += 1.0;
+            mx = vc.start[v + 1] > vc.start[v] ? 1.0 : 0.0;
+        }
+        s0[v] = sum;
+        wmax = std::max(wmax, mx);
+    }
     wmax = std::max(wmax, std::numeric_limits<double>::min());
-    // frames
-    std::vector<double> E((size_t)nV * 6);
-    for (i64 v = 0; v < nV; ++v) {
-        double n[3];
-        for (int a = 0; a < 3; ++a) n[a] = std::isfinite(N[3 * v + a]) ? N[3 * v + a] : 0.0;
-        if (!ref[v]) { n[0] = 0.0; n[1] = 0.0; n[2] = 1.0; }
-        tangent_frame(n, &E[6 * v], &E[6 * v + 3]);
-    }
-    auto offsets = [&](i64 f, i64 v, double& u, double& t) {
-        const double* x0 = V + 3 * F[3 * f];
-        const double* x1 = V + 3 * F[3 * f + 1];
-        const double* x2 = V + 3 * F[3 * f + 2];
-        double d[3];
-        for (int a = 0; a < 3; ++a) d[a] = ((x0[a] + x1[a] + x2[a]) / 3.0 - V[3 * v + a]) / h;
-        u = dot3(d, &E[6 * v]);
-        t = dot3(d, &E[6 * v + 3]);
-    };
-    // moments of the weighted fit: a, b, c, d, e, f = sum W (1, u, v, uu, uv, vv)
-    std::vector<double> mom((size_t)nV * 6, 0.0);
-    for (i64 f = 0; f < nF; ++f)
-        for (int c = 0; c < 3; ++c) {
-            const i64 v = F[3 * f + c];
-            double u, t;
-            offsets(f, v, u, t);
-            const double W = corner_weight(f, c) / wmax;
-            double* m = &mom[6 * v];
-            m[0] += W; m[1] += W * u; m[2] += W * t;
-            m[3] += W * u * u; m[4] += W * u * t; m[5] += W * t * t;
-        }
-    // per vertex: g / det of the fit (3 values) and whether it is well posed
-    std::vector<double> g((size_t)nV * 3, 0.0);
-    std::vector<unsigned char> good(nV, 0);
-    for (i64 v = 0; v < nV; ++v) {
-        const double* m = &mom[6 * v];
-        const double a = m[0], b = m[1], c = m[2], d = m[3], e = m[4], ff = m[5];
-        const double g0 = d * ff - e * e, g1 = c * e - b * ff, g2 = b * e - c * d;
-        const double det = a * g0 + b * g1 + c * g2;
-        const double mu = b / a, mv = c / a;
-        const double cuu = d / a - mu * mu, cuv = e / a - mu * mv, cvv = ff / a - mv * mv;
-        const double tr = cuu + cvv;
-        good[v] = ref[v] && !lost[v] && a > 0 && (cuu * cvv - cuv * cuv > 0.05 * tr * tr) &&
-                  (tr > 0.05 * (d + ff) / a) && std::isfinite(det) && det != 0.0;
-        g[3 * v] = g0 / det; g[3 * v + 1] = g1 / det; g[3 * v + 2] = g2 / det;
-    }
-    for (i64 f = 0; f < nF; ++f)
-        for (int c = 0; c < 3; ++c) {
-            const i64 v = F[3 * f + c];
-            double k;
-            if (good[v]) {
-                double u, t;
-                offsets(f, v, u, t);
-                const double W = corner_weight(f, c) / wmax;
-                k = W * (g[3 * v] + g[3 * v + 1] * u + g[3 * v + 2] * t);
-            } else {
-                k = corner_weight(f, c) / s0[v];
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel num_threads(nt)
+#endif
+    {
+        std::vector<double> off;   // this vertex's corner offsets (u, t)
+#ifdef IGL_HHJ_OPENMP
+#pragma omp for schedule(static)
+#endif
+        for (i64 v = 0; v < nV; ++v) {
+            const i64 q0 = vc.start[v], deg = vc.start[v + 1] - q0;
+            double n[3], e1[3], e2[3];
+            for (int a = 0; a < 3; ++a) n[a] = std::isfinite(N[3 * v + a]) ? N[3 * v + a] : 0.0;
+            if (!ref[v]) { n[0] = 0.0; n[1] = 0.0; n[2] = 1.0; }
+            tangent_frame(n, e1, e2);
+            off.resize((size_t)deg * 2);
+            // moments of the weighted fit: a, b, c, d, e, f = sum W (1, u, v, uu, uv, vv)
+            double m[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+            for (i64 k = 0; k < deg; ++k) {
+                const i64 f = vc.corner[q0 + k] / 3;
+                const int c = (int)(vc.corner[q0 + k] % 3);
+                const double* x0 = V + 3 * F[3 * f];
+                const double* x1 = V + 3 * F[3 * f + 1];
+                const double* x2 = V + 3 * F[3 * f + 2];
+                double d[3];
+                for (int a = 0; a < 3; ++a) d[a] = ((x0[a] + x1[a] + x2[a]) / 3.0 - V[3 * v + a]) / h;
+                const double u = dot3(d, e1), t = dot3(d, e2);
+                off[2 * k] = u; off[2 * k + 1] = t;
+                const double W = (lost[v] ? 1.0 : cw(f, c)) / wmax;
+                m[0] += W; m[1] += W * u; m[2] += W * t;
+                m[3] += W * u * u; m[4] += W * u * t; m[5] += W * t * t;
             }
-            if (!std::isfinite(k)) k = 0.0;
-            emit(f, c, v, k);
+            // g / det of the fit (3 values) and whether it is well posed
+            const double a = m[0], b = m[1], c = m[2], d = m[3], e = m[4], ff = m[5];
+            const double g0 = d * ff - e * e, g1 = c * e - b * ff, g2 = b * e - c * d;
+            const double det = a * g0 + b * g1 + c * g2;
+            const double mu = b / a, mv = c / a;
+            const double cuu = d / a - mu * mu, cuv = e / a - mu * mv, cvv = ff / a - mv * mv;
+            const double tr = cuu + cvv;
+            const bool good = ref[v] && !lost[v] && a > 0 && (cuu * cvv - cuv * cuv > 0.05 * tr * tr) &&
+                              (tr > 0.05 * (d + ff) / a) && std::isfinite(det) && det != 0.0;
+            const double G0 = g0 / det, G1 = g1 / det, G2 = g2 / det;
+            for (i64 k = 0; k < deg; ++k) {
+                const i64 f = vc.corner[q0 + k] / 3;
+                const int cc = (int)(vc.corner[q0 + k] % 3);
+                const double W = lost[v] ? 1.0 : cw(f, cc);
+                double kv = good ? W / wmax * (G0 + G1 * off[2 * k] + G2 * off[2 * k + 1]) : W / s0[v];
+                if (!std::isfinite(kv)) kv = 0.0;
+                emit(f, cc, v, kv);
+            }
+            done(v);
         }
+    }
 }
 
 // patch_recovery: X[v] (6 components) = sum_{T ∋ v} k_{v,T} S_T (patch_fit with the face
 // weights w).  S (#F,9), w (#F,), h the mean edge length; X (#V,6), rows of
 // unreferenced vertices 0.
 void patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S, const double* N,
-                    const double* w, const unsigned char* ref, double h, double* X) {
+                    const double* w, const unsigned char* ref, double h, double* X, int nt) {
     std::fill(X, X + (size_t)nV * 6, 0.0);
-    patch_fit(V, F, nF, nV, N, ref, h, [&](i64 f, int) { return w[f]; },
+    const VertexCorners vc(F, nF, nV);
+    patch_fit(V, F, nF, nV, N, ref, h, vc, [&](i64 f, int) { return w[f]; },
               [&](i64 f, int, i64 v, double k) {
                   const double* Sf = S + 9 * f;
                   for (int s = 0; s < 6; ++s) X[6 * v + s] += k * Sf[3 * SYM[s][0] + SYM[s][1]];
-              });
+              },
+              [](i64) {}, nt);
 }
 
 // intrinsic_patch_recovery (intrinsic.recover): the corner components (h, Re z, Im z) of
@@ -181,11 +184,16 @@ void intrinsic_patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, con
     // components and cosines in one pass over faces (parallel: no scatter)
     std::vector<double> fr((size_t)nV * 9);
     normal_frames(N, nV, fr.data(), nt);
-    std::vector<double> Y((size_t)nF * 9), cosine((size_t)nF * 3);
+    std::vector<double> Y((size_t)nF * 9), cosine((size_t)nF * 3), hT(rough ? nF : 0);
 #ifdef IGL_HHJ_OPENMP
 #pragma omp parallel for schedule(static) num_threads(nt)
 #endif
     for (i64 f = 0; f < nF; ++f) {
+        if (rough) {
+            double l[3];
+            face_lengths(V, F, f, l);
+            hT[f] = (l[0] + l[1] + l[2]) / 3.0;
+        }
         double c[3];
         face_cross(V, F, f, c);
         const double nc = std::sqrt(dot3(c, c));
@@ -210,35 +218,33 @@ void intrinsic_patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, con
     }
     std::vector<double>().swap(fr);
     std::fill(X, X + (size_t)nV * 3, 0.0);
-    patch_fit(V, F, nF, nV, N, ref, h, [&](i64 f, int c) { return cosine[3 * f + c] > 0 ? w[f] : 0.0; },
+    const VertexCorners vc(F, nF, nV);
+    patch_fit(V, F, nF, nV, N, ref, h, vc, [&](i64 f, int c) { return cosine[3 * f + c] > 0 ? w[f] : 0.0; },
               [&](i64 f, int c, i64 v, double k) {
                   const double* y = &Y[9 * f + 3 * c];
                   for (int q = 0; q < 3; ++q) X[3 * v + q] += k * y[q];
-              });
-    if (!rough) return;
-    std::vector<double> acc((size_t)nV * 3, 0.0);     // sum |T| d^2, sum |T|, sum h_T
-    std::vector<i64> cnt(nV, 0);
-    for (i64 f = 0; f < nF; ++f) {
-        double l[3];
-        face_lengths(V, F, f, l);
-        const double hT = (l[0] + l[1] + l[2]) / 3.0;
-        for (int k = 0; k < 3; ++k) {
-            const double area = cosine[3 * f + k] > 0 ? w[f] : 0.0;   // the fit's corner weight
-            const i64 v = F[3 * f + k];
-            const double* y = &Y[9 * f + 3 * k];
-            double d2 = 0.0;
-            for (int q = 0; q < 3; ++q) d2 += (y[q] - X[3 * v + q]) * (y[q] - X[3 * v + q]);
-            acc[3 * v] += area * d2;
-            acc[3 * v + 1] += area;
-            acc[3 * v + 2] += hT;
-            ++cnt[v];
-        }
-    }
-    for (i64 v = 0; v < nV; ++v) {
-        const double r = cnt[v] && acc[3 * v + 1] > 0
-                             ? acc[3 * v + 2] / cnt[v] * std::sqrt(acc[3 * v] / acc[3 * v + 1]) : 0.0;
-        rough[v] = std::isfinite(r) ? r : 0.0;
-    }
+              },
+              [&](i64 v) {
+                  if (!rough) return;
+                  // sum |T| d^2, sum |T| (the fit's corner weights), sum h_T over v's corners
+                  double a0 = 0.0, a1 = 0.0, a2 = 0.0;
+                  const i64 q0 = vc.start[v], q1 = vc.start[v + 1];
+                  for (i64 q = q0; q < q1; ++q) {
+                      const i64 f = vc.corner[q] / 3;
+                      const int k = (int)(vc.corner[q] % 3);
+                      const double area = cosine[3 * f + k] > 0 ? w[f] : 0.0;
+                      const double* y = &Y[9 * f + 3 * k];
+                      double d2 = 0.0;
+                      for (int c = 0; c < 3; ++c) d2 += (y[c] - X[3 * v + c]) * (y[c] - X[3 * v + c]);
+                      a0 += area * d2;
+                      a1 += area;
+                      a2 += hT[f];
+                  }
+                  const i64 cnt = q1 - q0;
+                  const double r = cnt && a1 > 0 ? a2 / cnt * std::sqrt(a0 / a1) : 0.0;
+                  rough[v] = std::isfinite(r) ? r : 0.0;
+              },
+              nt);
 }
 
 // tangent_projection6: X[r] <- P S P (symmetrised) + keep_trace * (N^T S N) P / 2,
