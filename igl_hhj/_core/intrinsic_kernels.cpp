@@ -481,6 +481,12 @@ struct HZProblem {
         std::copy(acc.begin(), acc.end(), X);
         return 0;
     }
+
+    // frees the work vectors (between the pilot and the final smoothing, so that the
+    // adaptive radius's temporaries do not add to them: the memory peak stays that of a solve)
+    void release_work() {
+        for (auto* v : {&Y, &R, &AY, &dY, &acc, &wr, &wp, &wq}) std::vector<double>().swap(*v);
+    }
 };
 
 }  // namespace
@@ -503,6 +509,7 @@ int intrinsic_smoothing(const double* V, const i64* F, i64 nF, i64 nV, const i64
     P.fill(t.data(), nt);
     int status = P.run(pilot.data(), 1, {1.0}, pilot_rtol, maxiter, nt, iterations);
     if (status != 0) return status;
+    P.release_work();
     adaptive_radius(V, F, nF, nV, pilot.data(), rough, radius, gain, power, lo, hi, r, nt);
     std::vector<double>().swap(pilot);
     face_times(V, F, nF, r, 1, per_radius, steps, t.data(), nt);
