@@ -1,4 +1,5 @@
-// The only file that knows nanobind: ndarrays in (C-contiguous float64 / int64,
+// The only file that knows nanobind: ndarrays in (C-contiguous float64 / int64, the
+// topology maps int32 / int8 as TriangleMesh stores them,
 // shapes checked in igl_hhj/kernels.py and again here where an index could go
 // out of bounds), ndarrays out (owned by Python), the GIL released around work.
 #include <nanobind/nanobind.h>
@@ -14,6 +15,8 @@
 namespace nb = nanobind;
 using namespace nb::literals;
 using hhj::i64;
+using hhj::i32;
+using hhj::i8;
 
 template <class T>
 using In = nb::ndarray<const T, nb::c_contig, nb::device::cpu>;
@@ -68,8 +71,8 @@ NB_MODULE(_hhj_core, m) {
     m.def("topology", [](In<i64> F, i64 nV) {
         need(F.ndim() == 2 && F.shape(1) == 3, "F must be (#F, 3)");
         const i64 nF = F.shape(0);
-        need(3 * nF < ((i64)1 << 32) && nV < ((i64)1 << 32),
-             "topology: at most 1 431 655 765 faces and 2**32 - 1 vertices");
+        need(3 * nF < ((i64)1 << 32) && nV < ((i64)1 << 31),
+             "topology: at most 1 431 655 765 faces and 2**31 - 1 vertices (int32 edge maps)");
         hhj::Topology T;
         {
             nb::gil_scoped_release nogil;
@@ -114,7 +117,7 @@ NB_MODULE(_hhj_core, m) {
         return nb::make_tuple(to_numpy(std::move(s), {(size_t)nV, 3}), to_numpy(std::move(a), {(size_t)nV}));
     });
 
-    m.def("edge_morton_order", [](In<double> V, In<i64> E) {
+    m.def("edge_morton_order", [](In<double> V, In<i32> E) {
         need(V.ndim() == 2 && V.shape(1) == 3 && E.ndim() == 2 && E.shape(1) == 2, "edge_morton_order: shapes");
         const i64 nE = E.shape(0);
         std::vector<i64> perm(nE);
@@ -126,7 +129,7 @@ NB_MODULE(_hhj_core, m) {
         return to_numpy(std::move(perm), {(size_t)nE});
     });
 
-    m.def("hhj_system", [](In<double> V, In<i64> F, In<i64> FE, In<i64> EF, In<i64> ELI,
+    m.def("hhj_system", [](In<double> V, In<i64> F, In<i32> FE, In<i32> EF, In<i8> ELI,
                            std::optional<In<unsigned char>> fixed, bool schwarz) {
         const i64 nF = F.shape(0), nE = EF.shape(0);
         need(FE.shape(0) == (size_t)nF && ELI.shape(0) == (size_t)nE, "hhj_system: inconsistent shapes");
@@ -158,7 +161,7 @@ NB_MODULE(_hhj_core, m) {
                               Mout, n_jacobi, to_numpy(std::move(sin_min), {(size_t)nF}));
     }, "V"_a, "F"_a, "FE"_a, "EF"_a, "ELI"_a, "fixed"_a.none(), "schwarz"_a);
 
-    m.def("jump_apply", [](In<double> V, In<i64> F, In<i64> EF, In<i64> ELI, In<double> W) {
+    m.def("jump_apply", [](In<double> V, In<i64> F, In<i32> EF, In<i8> ELI, In<double> W) {
         const i64 nF = F.shape(0), nE = EF.shape(0);
         need(W.ndim() == 2 && W.shape(0) == V.shape(0), "jump_apply: W must be (#V, k)");
         const int k = (int)W.shape(1);
@@ -274,7 +277,7 @@ NB_MODULE(_hhj_core, m) {
         return nb::make_tuple(to_numpy(std::move(X), {(size_t)n, (size_t)k}), status);
     });
 
-    m.def("shape_operator_faces", [](In<double> V, In<i64> F, In<i64> FE, In<double> s) {
+    m.def("shape_operator_faces", [](In<double> V, In<i64> F, In<i32> FE, In<double> s) {
         const i64 nF = F.shape(0);
         need(s.ndim() == 2 && s.shape(1) == 3, "shape_operator_faces: s must be (#E, 3)");
         std::vector<double> S((size_t)nF * 9);
@@ -286,7 +289,7 @@ NB_MODULE(_hhj_core, m) {
         return to_numpy(std::move(S), {(size_t)nF, 3, 3});
     });
 
-    m.def("face_tensors", [](In<double> V, In<i64> F, In<i64> FE, In<double> s) {
+    m.def("face_tensors", [](In<double> V, In<i64> F, In<i32> FE, In<double> s) {
         const i64 nF = F.shape(0);
         need(s.ndim() == 2, "face_tensors: s must be (#E, k)");
         const int k = (int)s.shape(1);
@@ -325,7 +328,7 @@ NB_MODULE(_hhj_core, m) {
                               to_numpy(std::move(PV1), {nn}), to_numpy(std::move(PV2), {nn}));
     });
 
-    m.def("recovery_weights", [](In<double> V, In<i64> F, In<i64> FE, In<i64> EF, double floor) {
+    m.def("recovery_weights", [](In<double> V, In<i64> F, In<i32> FE, In<i32> EF, double floor) {
         const i64 nF = F.shape(0), nE = EF.shape(0);
         need(FE.shape(0) == (size_t)nF && FE.shape(1) == 3 && EF.ndim() == 2 && EF.shape(1) == 2,
              "recovery_weights: shapes");
@@ -364,7 +367,7 @@ NB_MODULE(_hhj_core, m) {
         hhj::tangent_projection6(X.data(), N.data(), ref.data(), n, keep_trace, tb.nt);
     });
 
-    m.def("smooth_vertex_tensors", [](In<i64> E, In<i64> EF, In<i64> ELI, In<double> C, In<double> mass,
+    m.def("smooth_vertex_tensors", [](In<i32> E, In<i32> EF, In<i8> ELI, In<double> C, In<double> mass,
                                       nb::ndarray<double, nb::c_contig, nb::device::cpu> X, double t, int steps,
                                       std::vector<double> binom, double rtol, i64 maxiter) {
         const i64 nV = X.shape(0), nE = E.shape(0);
@@ -373,7 +376,7 @@ NB_MODULE(_hhj_core, m) {
              "smooth_vertex_tensors: topology shapes");
         need(nV < ((i64)1 << 31), "smooth_vertex_tensors: at most 2**31 - 1 vertices");
         const i64 nF = C.shape(0);
-        const i64* e = E.data();
+        const i32* e = E.data();
         for (i64 q = 0; q < 2 * nE; ++q) need(e[q] >= 0 && e[q] < nV, "smooth_vertex_tensors: edge index out of range");
         for (i64 q = 0; q < 2 * nE; ++q)
             need(EF.data()[q] < nF && ELI.data()[q] < 3, "smooth_vertex_tensors: edge_faces out of range");
@@ -403,7 +406,7 @@ NB_MODULE(_hhj_core, m) {
         return nb::make_tuple(to_numpy(std::move(X), {(size_t)nV, 3}), to_numpy(std::move(rough), {(size_t)nV}));
     });
 
-    m.def("vertex_components", [](In<i64> E, i64 nV) {
+    m.def("vertex_components", [](In<i32> E, i64 nV) {
         need(E.ndim() == 2 && E.shape(1) == 2, "vertex_components: E must be (#E, 2)");
         const i64 nE = E.shape(0);
         for (i64 q = 0; q < 2 * nE; ++q) need(E.data()[q] >= 0 && E.data()[q] < nV, "vertex_components: index out of range");
@@ -416,7 +419,7 @@ NB_MODULE(_hhj_core, m) {
         return nb::make_tuple(to_numpy(std::move(label), {(size_t)nV}), n);
     });
 
-    m.def("transport_phases", [](In<double> N, In<i64> E) {
+    m.def("transport_phases", [](In<double> N, In<i32> E) {
         const i64 nV = N.shape(0), nE = E.shape(0);
         need(N.ndim() == 2 && N.shape(1) == 3 && E.ndim() == 2 && E.shape(1) == 2, "transport_phases: shapes");
         for (i64 q = 0; q < 2 * nE; ++q) need(E.data()[q] >= 0 && E.data()[q] < nV, "transport_phases: index out of range");
@@ -429,7 +432,7 @@ NB_MODULE(_hhj_core, m) {
         return to_numpy(std::move(ph), {(size_t)nE, 2});
     });
 
-    m.def("boundary_normal_fits", [](In<double> X, In<i64> E, In<i64> verts, int rings, In<double> N0) {
+    m.def("boundary_normal_fits", [](In<double> X, In<i32> E, In<i64> verts, int rings, In<double> N0) {
         const i64 nV = X.shape(0), nE = E.shape(0), n = verts.shape(0);
         need(X.shape(1) == 3 && E.shape(1) == 2 && N0.shape(0) == (size_t)n && N0.shape(1) == 3,
              "boundary_normal_fits: shapes");
@@ -458,7 +461,7 @@ NB_MODULE(_hhj_core, m) {
         return to_numpy(std::move(r), {(size_t)nF});
     });
 
-    m.def("intrinsic_smoothing", [](In<double> V, In<i64> F, In<i64> E, In<i64> EF, In<i64> ELI, In<double> C,
+    m.def("intrinsic_smoothing", [](In<double> V, In<i64> F, In<i32> E, In<i32> EF, In<i8> ELI, In<double> C,
                                     In<double> mass, In<double> phase, In<double> rough,
                                     nb::ndarray<double, nb::c_contig, nb::device::cpu> X, double radius,
                                     double per_radius, double pilot_radius, double pilot_rtol, double gain,
