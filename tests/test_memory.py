@@ -5,7 +5,7 @@ the assembled system are alive while the compiled PCG holds its work vectors.  T
 is the bytes of the distinct arrays alive at the solve (arrays sharing memory with the
 input do not count: the drop-in's mesh views ``V`` and ``F``) plus the PCG's work set,
 per face; the resident peak measured by ``python -m igl_hhj.benchmarks.speed`` tracks it
-(0.43 KB/face on the 328k jittered ellipsoid; 0.51 with int64 topology maps).
+(0.425 KB/face on the jittered icosphere(7), 327,680 faces; 0.511 with int64 topology maps).
 """
 from functools import cached_property
 
@@ -21,8 +21,8 @@ from igl_hhj.surfaces import Sphere, icosphere, jitter_tangentially
 # KB/face above the input at the solve on this mesh: 0.418; 0.504 with int64 topology maps
 # (int32 edges / face_edges / edge_faces, int8 local indices, signs and counts: 88.5 B/face
 # less), 0.562 before the views of V, F (36 B/face), the int32 Morton permutations
-# (12 B/face) and the release of the face cross products (24 B/face).  The issue's target
-# is 0.45 (reached).
+# (12 B/face) and the release of the face cross products (24 B/face).  The issue's target,
+# a resident peak of 0.45 KB/face, is reached on icosphere(7) and its jittered version (0.425).
 SOLVE_BUDGET_KB_PER_FACE = 0.43
 # compiled block PCG on k right-hand sides (pcg.cpp): R (the caller's rhs, overwritten),
 # X, z, p, q, each (#E, k) float64
