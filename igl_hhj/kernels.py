@@ -295,8 +295,10 @@ def jump_apply(mesh, W):
 
 
 def ell_indptr(n, width=5):
-    """CSR row pointer of a fixed-width row format."""
-    return np.arange(0, width * n + 1, width, dtype=np.int64)
+    """(n + 1,) CSR row pointer of a fixed-width row format: int32 while ``width * n``
+    fits (memory: the HHJ system holds it at the solve; :func:`block_pcg` takes int32
+    row pointers as they are), else int64."""
+    return np.arange(0, width * n + 1, width, dtype=np.int32 if width * n < 2**31 else np.int64)
 
 
 def envelope_ldl_solve(indptr, indices, data, R, resid_rtol):
@@ -332,7 +334,9 @@ def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,
     mixing the columns by an orthogonal matrix (a rotation of the coordinate
     right-hand sides of Walker's eq. 5.14) mixes the iterates the same way.
 
-    Column indices travel as int32 (memory bandwidth: the sweeps are memory-bound).
+    Column indices travel as int32 (memory bandwidth: the sweeps are memory-bound).  Row
+    pointers: int32 when those of A and of M both are (passed without a copy, e.g.
+    :func:`ell_indptr`'s), else int64.
     Reference: :func:`igl_hhj.hhj._block_pcg`.  Preconditioner: ``M`` =
     ``(indptr, indices, data)`` of a CSR matrix, else Jacobi with ``dinv``; with
     ``subdomain`` (int64 indices S) and ``subdomain_solve(r_S, z_S)`` (writes
@@ -360,14 +364,17 @@ def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,
     n = R.shape[0]
     if n >= 2 ** 31:
         raise ValueError(f"block_pcg handles fewer than 2**31 unknowns, got {n}")
-    indptr, indices, data = _i64(indptr), _i32(indices), _f64(data, "data")
+    indptr = np.asarray(indptr)
+    narrow = indptr.dtype == np.int32 and (M is None or np.asarray(M[0]).dtype == np.int32)
+    idx = _i32 if narrow else _i64
+    indptr, indices, data = idx(indptr), _i32(indices), _f64(data, "data")
     if indptr.shape != (n + 1,) or indices.shape != data.shape or indptr[-1] > len(indices):
         raise ValueError("inconsistent CSR arrays for block_pcg")
     if len(indices) and (indices.min() < 0 or indices.max() >= n):
         raise ValueError("CSR column index out of range in block_pcg")
     Mp = Mi = Mx = None
     if M is not None:
-        Mp, Mi, Mx = _i64(M[0]), _i32(M[1]), _f64(M[2], "M")
+        Mp, Mi, Mx = idx(M[0]), _i32(M[1]), _f64(M[2], "M")
         if Mp.shape != (n + 1,) or Mi.shape != Mx.shape or (len(Mi) and (Mi.min() < 0 or Mi.max() >= n)):
             raise ValueError("inconsistent preconditioner CSR arrays for block_pcg")
     elif dinv is not None:
@@ -389,9 +396,9 @@ def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,
         elif subdomain_solve is None or not callable(subdomain_solve):
             raise TypeError("subdomain needs a callable subdomain_solve(r_S, z_S) or subdomain_ldl")
     _threads()
-    return _core.block_pcg(indptr, indices, data, Mp, Mi, Mx, dinv, R, float(rtol), int(maxiter),
-                           int(probe_iter), float(max_predicted), S,
-                           subdomain_solve if S is not None and ldl is None else None, ldl, bool(coupled))
+    return (_core.block_pcg32 if narrow else _core.block_pcg)(
+        indptr, indices, data, Mp, Mi, Mx, dinv, R, float(rtol), int(maxiter), int(probe_iter),
+        float(max_predicted), S, subdomain_solve if S is not None and ldl is None else None, ldl, bool(coupled))
 
 
 def shape_operator_faces(mesh, s):

@@ -18,12 +18,13 @@ from igl_hhj import kernels, solvers
 from igl_hhj.mesh import TriangleMesh, as_mesh
 from igl_hhj.surfaces import Sphere, icosphere, jitter_tangentially
 
-# KB/face above the input at the solve on this mesh: 0.418; 0.504 with int64 topology maps
-# (int32 edges / face_edges / edge_faces, int8 local indices, signs and counts: 88.5 B/face
-# less), 0.562 before the views of V, F (36 B/face), the int32 Morton permutations
-# (12 B/face) and the release of the face cross products (24 B/face).  The target,
-# a resident peak of 0.45 KB/face, is reached on icosphere(7) and its jittered version (0.425).
-SOLVE_BUDGET_KB_PER_FACE = 0.43
+# KB/face above the input at the solve on this mesh: 0.412; 0.418 with the int64 ELL row
+# pointer (6 B/face), 0.504 with int64 topology maps too (int32 edges / face_edges /
+# edge_faces, int8 local indices, signs and counts: 88.5 B/face less), 0.562 before the
+# views of V, F (36 B/face), the int32 Morton permutations (12 B/face) and the release of
+# the face cross products (24 B/face).  The target, a resident peak of 0.45
+# KB/face, is reached on icosphere(7) and its jittered version (docs/speed.md).
+SOLVE_BUDGET_KB_PER_FACE = 0.42
 # compiled block PCG on k right-hand sides (pcg.cpp): R (the caller's rhs, overwritten),
 # X, z, p, q, each (#E, k) float64
 PCG_WORK_ARRAYS = 5

@@ -34,6 +34,94 @@ static void need(bool ok, const char* what) {
     if (!ok) throw std::invalid_argument(what);
 }
 
+// block_pcg of the module, for either row-pointer type I of A and M
+template <class I>
+static nb::tuple block_pcg_py(In<I> Ap, In<std::int32_t> Ai, In<double> Ax, std::optional<In<I>> Mp,
+                              std::optional<In<std::int32_t>> Mi, std::optional<In<double>> Mx,
+                              std::optional<In<double>> dinv, nb::ndarray<double, nb::c_contig, nb::device::cpu> R,
+                              double rtol, i64 maxiter,
+                              i64 probe_iter, double max_predicted, std::optional<In<i64>> S,
+                              std::optional<nb::callable> subdomain_solve, std::optional<nb::tuple> subdomain_ldl,
+                              bool coupled) {
+    need(R.ndim() == 2, "block_pcg: R must be (n, k)");
+    const i64 n = R.shape(0);
+    const int k = (int)R.shape(1);
+    need(Ap.shape(0) == (size_t)n + 1, "block_pcg: indptr must have n + 1 entries");
+    need(Mp.has_value() || (dinv.has_value() && dinv->shape(0) == (size_t)n),
+         "block_pcg: need a preconditioner (CSR) or dinv (n,)");
+    std::vector<double> X((size_t)n * k);
+    hhj::PCGResult res;
+    hhj::SubdomainSolve sub;
+    if (S && (subdomain_ldl || subdomain_solve)) {
+        sub.S = S->data();
+        sub.nS = (i64)S->shape(0);
+        for (i64 i = 0; i < sub.nS; ++i) need(sub.S[i] >= 0 && sub.S[i] < n, "block_pcg: S index out of range");
+    }
+    // keeps the factor's arrays alive for the native solve below
+    std::optional<In<i64>> Lp, Li, perm;
+    std::optional<In<double>> Lx, D;
+    if (S && subdomain_ldl) {
+        need(subdomain_ldl->size() == 5, "block_pcg: subdomain_ldl must be (Lp, Li, Lx, D, perm)");
+        Lp = nb::cast<In<i64>>((*subdomain_ldl)[0]);
+        Li = nb::cast<In<i64>>((*subdomain_ldl)[1]);
+        Lx = nb::cast<In<double>>((*subdomain_ldl)[2]);
+        D = nb::cast<In<double>>((*subdomain_ldl)[3]);
+        perm = nb::cast<In<i64>>((*subdomain_ldl)[4]);
+        const i64 nS = sub.nS;
+        need(Lp->ndim() == 1 && Lp->shape(0) == (size_t)nS + 1 && D->shape(0) == (size_t)nS &&
+             perm->shape(0) == (size_t)nS && Li->shape(0) == Lx->shape(0),
+             "block_pcg: subdomain_ldl shapes do not match S");
+        const i64* lp = Lp->data();
+        need(lp[0] == 0 && lp[nS] == (i64)Li->shape(0), "block_pcg: subdomain_ldl Lp");
+        for (i64 j = 0; j < nS; ++j) {
+            need(lp[j] <= lp[j + 1], "block_pcg: subdomain_ldl Lp not monotone");
+            for (i64 q = lp[j]; q < lp[j + 1]; ++q)
+                need(Li->data()[q] > j && Li->data()[q] < nS, "block_pcg: subdomain_ldl L not strictly lower");
+        }
+        std::vector<unsigned char> seen(nS, 0);
+        for (i64 i = 0; i < nS; ++i) {
+            const i64 o = perm->data()[i];
+            need(o >= 0 && o < nS && !seen[o], "block_pcg: subdomain_ldl perm is not a permutation");
+            seen[o] = 1;
+        }
+        hhj::LDLFactor f;
+        f.n = nS;
+        f.Lp = lp;
+        f.Li = Li->data();
+        f.Lx = Lx->data();
+        f.D = D->data();
+        f.perm = perm->data();
+        hhj::ldl_schedule(f);
+        auto work = std::make_shared<std::vector<double>>((size_t)nS * k);
+        auto fac = std::make_shared<const hhj::LDLFactor>(std::move(f));
+        sub.solve = [fac, work, k](const double* rS, double* zS, int nt) {
+            hhj::ldl_solve_block(*fac, k, rS, zS, work->data(), nt);
+        };
+    } else if (S && subdomain_solve) {
+        const size_t nS = sub.nS, kk = k;
+        nb::callable fn = *subdomain_solve;
+        sub.solve = [fn, nS, kk](const double* rS, double* zS, int) {
+            nb::gil_scoped_acquire gil;
+            // rS is a scratch buffer: writable, so that solvers taking writable input accept it
+            nb::ndarray<nb::numpy, double> a(const_cast<double*>(rS), {nS, kk});
+            nb::ndarray<nb::numpy, double> b(zS, {nS, kk});
+            // reference policy: the callee writes into zS itself (no copies)
+            fn(nb::cast(a, nb::rv_policy::reference), nb::cast(b, nb::rv_policy::reference));
+        };
+    }
+    {
+        nb::gil_scoped_release nogil;
+        hhj::ThreadBudget tb(n * k, hhj::PCG_MIN_WORK);
+        res = hhj::block_pcg(n, k, Ap.data(), Ai.data(), Ax.data(),
+                             Mp ? Mp->data() : nullptr, Mp ? Mi->data() : nullptr,
+                             Mp ? Mx->data() : nullptr, dinv ? dinv->data() : nullptr,
+                             R.data(), X.data(), rtol, maxiter, probe_iter, max_predicted, tb.nt,
+                             sub.nS ? &sub : nullptr, coupled);
+    }
+    return nb::make_tuple(to_numpy(std::move(X), {(size_t)n, (size_t)k}), res.iterations, res.status,
+                          res.relres);
+}
+
 NB_MODULE(_hhj_core, m) {
     m.doc() = "igl_hhj compiled core (use igl_hhj.kernels, not this module directly)";
 
@@ -174,91 +262,9 @@ NB_MODULE(_hhj_core, m) {
         return to_numpy(std::move(out), {(size_t)nE, (size_t)k});
     });
 
-    m.def("block_pcg", [](In<i64> Ap, In<std::int32_t> Ai, In<double> Ax, std::optional<In<i64>> Mp,
-                          std::optional<In<std::int32_t>> Mi, std::optional<In<double>> Mx,
-                          std::optional<In<double>> dinv, nb::ndarray<double, nb::c_contig, nb::device::cpu> R,
-                          double rtol, i64 maxiter,
-                          i64 probe_iter, double max_predicted, std::optional<In<i64>> S,
-                          std::optional<nb::callable> subdomain_solve, std::optional<nb::tuple> subdomain_ldl,
-                          bool coupled) {
-        need(R.ndim() == 2, "block_pcg: R must be (n, k)");
-        const i64 n = R.shape(0);
-        const int k = (int)R.shape(1);
-        need(Ap.shape(0) == (size_t)n + 1, "block_pcg: indptr must have n + 1 entries");
-        need(Mp.has_value() || (dinv.has_value() && dinv->shape(0) == (size_t)n),
-             "block_pcg: need a preconditioner (CSR) or dinv (n,)");
-        std::vector<double> X((size_t)n * k);
-        hhj::PCGResult res;
-        hhj::SubdomainSolve sub;
-        if (S && (subdomain_ldl || subdomain_solve)) {
-            sub.S = S->data();
-            sub.nS = (i64)S->shape(0);
-            for (i64 i = 0; i < sub.nS; ++i) need(sub.S[i] >= 0 && sub.S[i] < n, "block_pcg: S index out of range");
-        }
-        // keeps the factor's arrays alive for the native solve below
-        std::optional<In<i64>> Lp, Li, perm;
-        std::optional<In<double>> Lx, D;
-        if (S && subdomain_ldl) {
-            need(subdomain_ldl->size() == 5, "block_pcg: subdomain_ldl must be (Lp, Li, Lx, D, perm)");
-            Lp = nb::cast<In<i64>>((*subdomain_ldl)[0]);
-            Li = nb::cast<In<i64>>((*subdomain_ldl)[1]);
-            Lx = nb::cast<In<double>>((*subdomain_ldl)[2]);
-            D = nb::cast<In<double>>((*subdomain_ldl)[3]);
-            perm = nb::cast<In<i64>>((*subdomain_ldl)[4]);
-            const i64 nS = sub.nS;
-            need(Lp->ndim() == 1 && Lp->shape(0) == (size_t)nS + 1 && D->shape(0) == (size_t)nS &&
-                 perm->shape(0) == (size_t)nS && Li->shape(0) == Lx->shape(0),
-                 "block_pcg: subdomain_ldl shapes do not match S");
-            const i64* lp = Lp->data();
-            need(lp[0] == 0 && lp[nS] == (i64)Li->shape(0), "block_pcg: subdomain_ldl Lp");
-            for (i64 j = 0; j < nS; ++j) {
-                need(lp[j] <= lp[j + 1], "block_pcg: subdomain_ldl Lp not monotone");
-                for (i64 q = lp[j]; q < lp[j + 1]; ++q)
-                    need(Li->data()[q] > j && Li->data()[q] < nS, "block_pcg: subdomain_ldl L not strictly lower");
-            }
-            std::vector<unsigned char> seen(nS, 0);
-            for (i64 i = 0; i < nS; ++i) {
-                const i64 o = perm->data()[i];
-                need(o >= 0 && o < nS && !seen[o], "block_pcg: subdomain_ldl perm is not a permutation");
-                seen[o] = 1;
-            }
-            hhj::LDLFactor f;
-            f.n = nS;
-            f.Lp = lp;
-            f.Li = Li->data();
-            f.Lx = Lx->data();
-            f.D = D->data();
-            f.perm = perm->data();
-            hhj::ldl_schedule(f);
-            auto work = std::make_shared<std::vector<double>>((size_t)nS * k);
-            auto fac = std::make_shared<const hhj::LDLFactor>(std::move(f));
-            sub.solve = [fac, work, k](const double* rS, double* zS, int nt) {
-                hhj::ldl_solve_block(*fac, k, rS, zS, work->data(), nt);
-            };
-        } else if (S && subdomain_solve) {
-            const size_t nS = sub.nS, kk = k;
-            nb::callable fn = *subdomain_solve;
-            sub.solve = [fn, nS, kk](const double* rS, double* zS, int) {
-                nb::gil_scoped_acquire gil;
-                // rS is a scratch buffer: writable, so that solvers taking writable input accept it
-                nb::ndarray<nb::numpy, double> a(const_cast<double*>(rS), {nS, kk});
-                nb::ndarray<nb::numpy, double> b(zS, {nS, kk});
-                // reference policy: the callee writes into zS itself (no copies)
-                fn(nb::cast(a, nb::rv_policy::reference), nb::cast(b, nb::rv_policy::reference));
-            };
-        }
-        {
-            nb::gil_scoped_release nogil;
-            hhj::ThreadBudget tb(n * k, hhj::PCG_MIN_WORK);
-            res = hhj::block_pcg(n, k, Ap.data(), Ai.data(), Ax.data(),
-                                 Mp ? Mp->data() : nullptr, Mp ? Mi->data() : nullptr,
-                                 Mp ? Mx->data() : nullptr, dinv ? dinv->data() : nullptr,
-                                 R.data(), X.data(), rtol, maxiter, probe_iter, max_predicted, tb.nt,
-                                 sub.nS ? &sub : nullptr, coupled);
-        }
-        return nb::make_tuple(to_numpy(std::move(X), {(size_t)n, (size_t)k}), res.iterations, res.status,
-                              res.relres);
-    });
+    // int64 row pointers (scipy matrices) and int32 ones (the HHJ system: memory)
+    m.def("block_pcg", &block_pcg_py<i64>);
+    m.def("block_pcg32", &block_pcg_py<i32>);
 
     m.def("envelope_ldl_solve", [](In<i64> Ap, In<std::int32_t> Ai, In<double> Ax, In<double> R,
                                    double resid_rtol) {

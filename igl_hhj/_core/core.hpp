@@ -266,8 +266,10 @@ struct LDLFactor {
 // greedily, heaviest first, to the group with less work (nonzeros + 1 per column).
 void ldl_schedule(LDLFactor& f);
 void ldl_solve_block(const LDLFactor& f, int k, const double* r, double* z, double* w, int nt);
-PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const double* Ax,
-                    const i64* Mp, const std::int32_t* Mi, const double* Mx, const double* dinv,
+// I = i64 or i32: the row pointers of A and M (explicitly instantiated in pcg.cpp)
+template <class I>
+PCGResult block_pcg(i64 n, int k, const I* Ap, const std::int32_t* Ai, const double* Ax,
+                    const I* Mp, const std::int32_t* Mi, const double* Mx, const double* dinv,
                     double* R, double* X, double rtol, i64 maxiter,
                     i64 probe_iter, double max_predicted, int nt,
                     const SubdomainSolve* sub = nullptr, bool coupled = false);

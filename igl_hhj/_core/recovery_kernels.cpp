@@ -342,9 +342,9 @@ int smooth_vertex_tensors(i64 nV, const i32* E, i64 nE, const i32* EF, const i8*
                 }
                 for (int c = 0; c < 6; ++c) R[6 * v + c] = m[v] * Y[6 * v + c] - acc[c];
             }
-            PCGResult res = block_pcg(nV, 6, indptr.data(), indices.data(), A.data(), nullptr, nullptr,
-                                      nullptr, dinv.data(), R.data(), dY.data(), rtol, maxiter, 0,
-                                      std::numeric_limits<double>::infinity(), nt);
+            PCGResult res = block_pcg<i64>(nV, 6, indptr.data(), indices.data(), A.data(), nullptr, nullptr,
+                                           nullptr, dinv.data(), R.data(), dY.data(), rtol, maxiter, 0,
+                                           std::numeric_limits<double>::infinity(), nt);
             *iterations += res.iterations;
             if (res.status != 0) return res.status;
             for (size_t q = 0; q < n6; ++q) Y[q] += std::isfinite(dY[q]) ? dY[q] : 0.0;
