@@ -45,8 +45,8 @@ Numerical-robustness policy (one set of limits for every solver)
   indices, signs and counts int8 (``edge_local_index``, ``face_edge_sign``,
   ``edge_face_count``).  Indexing, ``np.bincount`` and scipy.sparse take them as they
   are; cast to int64 before arithmetic that can exceed 2³¹ (``3 * f + i``,
-  ``edges[:, 0] * #V``).  A mesh needs fewer than 2³¹ vertices and unique edges
-  (else ``ValueError``).
+  ``edges[:, 0] * #V``).  A mesh needs fewer than 2³¹ vertices, faces and unique
+  edges (else ``ValueError``).
 """
 from __future__ import annotations
 
@@ -324,7 +324,7 @@ class TriangleMesh:
     def face_edge_sign(self):
         """(#F, 3) int8: +1 where the half-edge ``x_{i+1} → x_{i+2}`` of face f
         runs in the direction of the unique edge ``edges[face_edges[f, i]]``, else -1
-        (multiplying a float array by it gives float64, the same bits as a ±1.0 factor)."""
+        (a float64 array times it: float64, the same bits as with a ±1.0 factor)."""
         return self._topology[5]
 
     @cached_property

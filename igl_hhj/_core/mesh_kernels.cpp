@@ -14,7 +14,7 @@ namespace hhj {
 // half-edge runs min->max), sign (#F,3) (+1 where the half-edge x_{i+1}->x_{i+2}
 // runs min->max).  On non-manifold edges (count > 2) the last faces win.  The maps are
 // int32 (indices) and int8 (counts saturated at 127, local indices, signs); at most
-// 2^31 - 2 unique edges and vertex indices below 2^31 (checked by the binding).
+// 2^31 - 1 unique edges (checked here) and vertex indices below 2^31 (the binding).
 void topology(const i64* F, i64 nF, i64 nV, Topology& T) {
     const i64 nH = 3 * nF;
     // half-edge h = 3f + i gets the key (hi << 32) | h, bucketed by its lower vertex: sorting
@@ -61,9 +61,9 @@ void topology(const i64* F, i64 nF, i64 nV, Topology& T) {
             const i64 h = (i64)(order[p] & 0xffffffffULL);
             const i64 hi = (i64)(order[p] >> 32);
             if (v != prev_lo || hi != prev_hi) {
-                if (nE == INT32_MAX)     // the int32 maps hold edge indices up to 2^31 - 2
-                    throw std::invalid_argument("topology: the mesh has 2**31 - 1 or more unique edges; "
-                                                "igl_hhj's int32 edge maps hold fewer");
+                if (nE == INT32_MAX)     // the int32 maps hold at most 2^31 - 1 edges
+                    throw std::invalid_argument("topology: the mesh has 2**31 or more unique edges; "
+                                                "igl_hhj's int32 edge maps hold at most 2**31 - 1");
                 T.edges.push_back((i32)v);
                 T.edges.push_back((i32)hi);
                 prev_lo = v; prev_hi = hi;
