@@ -101,7 +101,8 @@ def _edge_index(mesh, pairs, name):
         raise TypeError(f"{name} must hold integer vertex indices, got dtype {P.dtype}")
     P = np.sort(P.astype(np.int64), axis=1)
     nV = mesh.n_vertices
-    key = mesh.edges[:, 0] * nV + mesh.edges[:, 1]             # edges are sorted lexicographically
+    E = mesh.edges.astype(np.int64)                            # int32: the key needs int64
+    key = E[:, 0] * nV + E[:, 1]                               # edges are sorted lexicographically
     k = P[:, 0] * nV + P[:, 1]
     pos = np.searchsorted(key, k)
     pos = np.minimum(pos, len(key) - 1)
@@ -197,7 +198,7 @@ def crease_network(mesh: TriangleMesh, crease: NDArray[np.bool_],
     """Chains, corners and line measure of the crease edges ``crease`` ((#E,) bool);
     ``theta``: :func:`dihedral_angles` if already computed."""
     idx = np.flatnonzero(crease)
-    E = mesh.edges[idx]
+    E = mesh.edges[idx].astype(np.int64)                       # int64 for the users (mesh.edges is int32)
     nV = mesh.n_vertices
     deg = np.bincount(E.ravel(), minlength=nV)
     # two crease edges belong to one chain where they share a vertex of crease degree 2
@@ -252,8 +253,9 @@ def cut_along(mesh: TriangleMesh, crease: NDArray[np.bool_]) -> CutMesh:
     F = mesh.F
     nF, nV = mesh.n_faces, mesh.n_vertices
     keep = np.flatnonzero((mesh.edge_face_count == 2) & ~crease)
-    f0, f1 = mesh.edge_faces[keep, 0], mesh.edge_faces[keep, 1]
-    i0, i1 = mesh.edge_local_index[keep, 0], mesh.edge_local_index[keep, 1]
+    # int64 (the maps are int32 / int8): 3 f + i would overflow int32 above 715M faces
+    f0, f1 = mesh.edge_faces[keep, 0].astype(np.int64), mesh.edge_faces[keep, 1].astype(np.int64)
+    i0, i1 = mesh.edge_local_index[keep, 0].astype(np.int64), mesh.edge_local_index[keep, 1].astype(np.int64)
     # in f0 the edge runs x_{i0+1} → x_{i0+2}, in f1 the other way: corner i0+1 of f0 is
     # corner i1+2 of f1 (same vertex) and i0+2 of f0 is i1+1 of f1
     a = np.concatenate([3 * f0 + (i0 + 1) % 3, 3 * f0 + (i0 + 2) % 3])

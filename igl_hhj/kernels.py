@@ -1,8 +1,9 @@
 """Thin Python face of the compiled core ``igl_hhj._hhj_core`` (C++17, nanobind).
 
 This is the only module that imports the extension.  Every function checks and
-coerces its arrays once (C-contiguous float64 / int64, shapes) and hands them to
-one C++ kernel; the kernels have no hidden state and release the GIL.  The
+coerces its arrays once (C-contiguous float64 / int64, shapes; the topology maps of
+:class:`igl_hhj.mesh.TriangleMesh` as they are stored, int32 indices and int8 local
+indices, so no call copies them) and hands them to one C++ kernel; the kernels have no hidden state and release the GIL.  The
 readable numpy reference of each kernel is named in its docstring; tests
 (``tests/test_core.py``) compare the two.
 
@@ -63,6 +64,10 @@ def _i64(a):
 
 def _i32(a):
     return np.ascontiguousarray(a, dtype=np.int32)
+
+
+def _i8(a):
+    return np.ascontiguousarray(a, dtype=np.int8)
 
 
 _USER_THREADS = _core.max_threads()     # OMP_NUM_THREADS or the core count
@@ -192,14 +197,24 @@ def topology(F, n_vertices):
 
     Returns
     -------
-    edges : (#E, 2) int64, ``(min, max)`` vertex pairs in lexicographic order
+    edges : (#E, 2) int32, ``(min, max)`` vertex pairs in lexicographic order
         (the order of ``igl.unique_edge_map``'s ``uE``).
-    face_edges : (#F, 3) int64, the edge opposite corner i of face f.
-    count : (#E,) int64, faces per edge.
-    edge_faces, local_index : (#E, 2) int64, faces (column 0: the one whose
-        half-edge runs min → max) and the edge's local index there; -1 for none.
-    sign : (#F, 3) float64, +1 where the half-edge ``x_{i+1} → x_{i+2}`` runs min → max.
+    face_edges : (#F, 3) int32, the edge opposite corner i of face f.
+    count : (#E,) int8, faces per edge, saturated at 127.
+    edge_faces : (#E, 2) int32, faces (column 0: the one whose half-edge runs
+        min → max); -1 for none.
+    local_index : (#E, 2) int8, the edge's local index in those faces; -1 for none.
+    sign : (#F, 3) int8, +1 where the half-edge ``x_{i+1} → x_{i+2}`` runs min → max, else -1.
+
+    Raises
+    ------
+    ValueError
+        2³¹ or more vertices, faces or unique edges (the maps hold int32 indices).
     """
+    shape = getattr(F, "shape", None)
+    if shape is not None and len(shape) == 2 and (shape[0] >= 2**31 or int(n_vertices) >= 2**31):
+        raise ValueError(f"topology: at most 2**31 - 1 vertices, faces and unique edges (igl_hhj's "
+                         f"edge maps are int32), got {shape[0]} faces and {int(n_vertices)} vertices")
     F = _i64(F)
     if F.ndim != 2 or F.shape[1] != 3:
         raise ValueError(f"F must have shape (#F, 3), got {F.shape}")
@@ -227,7 +242,7 @@ def edge_morton_order(mesh):
     """(#E,) int64 permutation listing the edges by the Morton (Z-order) code of their
     midpoints: a cache-friendly numbering for the solver (the lexicographic edge order
     scatters neighbouring edges across memory)."""
-    return _core.edge_morton_order(mesh.V, _i64(mesh.edges))
+    return _core.edge_morton_order(mesh.V, _i32(mesh.edges))
 
 
 def hhj_system(mesh, fixed=None, schwarz=True, topology=None):
@@ -245,7 +260,8 @@ def hhj_system(mesh, fixed=None, schwarz=True, topology=None):
         Also build M.
     topology : (face_edges, edge_faces, edge_local_index), optional
         A renumbering of the mesh's edge maps (e.g. by :func:`edge_morton_order`);
-        rows, columns and ``fixed`` are then in that numbering.
+        rows, columns and ``fixed`` are then in that numbering.  int32, int32, int8
+        as the mesh stores them (other integer types are converted).
 
     Returns
     -------
@@ -260,7 +276,7 @@ def hhj_system(mesh, fixed=None, schwarz=True, topology=None):
     fx = None if fixed is None else np.ascontiguousarray(fixed, dtype=np.uint8)
     FE, EF, ELI = topology if topology is not None else \
         (mesh.face_edges, mesh.edge_faces, mesh.edge_local_index)
-    FE, EF, ELI = _i64(FE), _i64(EF), _i64(ELI)
+    FE, EF, ELI = _i32(FE), _i32(EF), _i8(ELI)
     nE = mesh.n_edges
     if FE.shape != (mesh.n_faces, 3) or EF.shape != (nE, 2) or ELI.shape != (nE, 2) \
             or (fx is not None and fx.shape != (nE,)):
@@ -275,12 +291,14 @@ def jump_apply(mesh, W):
     if W.ndim != 2 or W.shape[0] != mesh.n_vertices:
         raise ValueError(f"W must have shape ({mesh.n_vertices}, k), got {W.shape}")
     _threads()
-    return _core.jump_apply(mesh.V, mesh.F, _i64(mesh.edge_faces), _i64(mesh.edge_local_index), W)
+    return _core.jump_apply(mesh.V, mesh.F, _i32(mesh.edge_faces), _i8(mesh.edge_local_index), W)
 
 
 def ell_indptr(n, width=5):
-    """CSR row pointer of a fixed-width row format."""
-    return np.arange(0, width * n + 1, width, dtype=np.int64)
+    """(n + 1,) CSR row pointer of a fixed-width row format: int32 while ``width * n``
+    fits (memory: the HHJ system holds it at the solve; :func:`block_pcg` takes int32
+    row pointers as they are), else int64."""
+    return np.arange(0, width * n + 1, width, dtype=np.int32 if width * n < 2**31 else np.int64)
 
 
 def envelope_ldl_solve(indptr, indices, data, R, resid_rtol):
@@ -316,7 +334,9 @@ def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,
     mixing the columns by an orthogonal matrix (a rotation of the coordinate
     right-hand sides of Walker's eq. 5.14) mixes the iterates the same way.
 
-    Column indices travel as int32 (memory bandwidth: the sweeps are memory-bound).
+    Column indices travel as int32 (memory bandwidth: the sweeps are memory-bound).  Row
+    pointers: int32 when those of A and of M both are (passed without a copy, e.g.
+    :func:`ell_indptr`'s), else int64.
     Reference: :func:`igl_hhj.hhj._block_pcg`.  Preconditioner: ``M`` =
     ``(indptr, indices, data)`` of a CSR matrix, else Jacobi with ``dinv``; with
     ``subdomain`` (int64 indices S) and ``subdomain_solve(r_S, z_S)`` (writes
@@ -344,14 +364,17 @@ def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,
     n = R.shape[0]
     if n >= 2 ** 31:
         raise ValueError(f"block_pcg handles fewer than 2**31 unknowns, got {n}")
-    indptr, indices, data = _i64(indptr), _i32(indices), _f64(data, "data")
+    indptr = np.asarray(indptr)
+    narrow = indptr.dtype == np.int32 and (M is None or np.asarray(M[0]).dtype == np.int32)
+    idx = _i32 if narrow else _i64
+    indptr, indices, data = idx(indptr), _i32(indices), _f64(data, "data")
     if indptr.shape != (n + 1,) or indices.shape != data.shape or indptr[-1] > len(indices):
         raise ValueError("inconsistent CSR arrays for block_pcg")
     if len(indices) and (indices.min() < 0 or indices.max() >= n):
         raise ValueError("CSR column index out of range in block_pcg")
     Mp = Mi = Mx = None
     if M is not None:
-        Mp, Mi, Mx = _i64(M[0]), _i32(M[1]), _f64(M[2], "M")
+        Mp, Mi, Mx = idx(M[0]), _i32(M[1]), _f64(M[2], "M")
         if Mp.shape != (n + 1,) or Mi.shape != Mx.shape or (len(Mi) and (Mi.min() < 0 or Mi.max() >= n)):
             raise ValueError("inconsistent preconditioner CSR arrays for block_pcg")
     elif dinv is not None:
@@ -373,9 +396,9 @@ def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,
         elif subdomain_solve is None or not callable(subdomain_solve):
             raise TypeError("subdomain needs a callable subdomain_solve(r_S, z_S) or subdomain_ldl")
     _threads()
-    return _core.block_pcg(indptr, indices, data, Mp, Mi, Mx, dinv, R, float(rtol), int(maxiter),
-                           int(probe_iter), float(max_predicted), S,
-                           subdomain_solve if S is not None and ldl is None else None, ldl, bool(coupled))
+    return (_core.block_pcg32 if narrow else _core.block_pcg)(
+        indptr, indices, data, Mp, Mi, Mx, dinv, R, float(rtol), int(maxiter), int(probe_iter),
+        float(max_predicted), S, subdomain_solve if S is not None and ldl is None else None, ldl, bool(coupled))
 
 
 def shape_operator_faces(mesh, s):
@@ -384,7 +407,7 @@ def shape_operator_faces(mesh, s):
     Reference: :func:`igl_hhj.hhj.face_tensors` contracted with the face normals."""
     s = _f64(s, "s", (3,))
     _threads()
-    return _core.shape_operator_faces(mesh.V, mesh.F, _i64(mesh.face_edges), s)
+    return _core.shape_operator_faces(mesh.V, mesh.F, _i32(mesh.face_edges), s)
 
 
 def face_tensors(mesh, s):
@@ -393,7 +416,7 @@ def face_tensors(mesh, s):
     if s.ndim != 2 or s.shape[0] != mesh.n_edges:
         raise ValueError(f"s must have shape ({mesh.n_edges}, k), got {s.shape}")
     _threads()
-    return _core.face_tensors(mesh.V, mesh.F, _i64(mesh.face_edges), s)
+    return _core.face_tensors(mesh.V, mesh.F, _i32(mesh.face_edges), s)
 
 
 def lumped_vertex_recovery(mesh, S, N):
@@ -431,7 +454,7 @@ def recovery_weights(mesh, quality_floor):
     """Face weights ``|T| min(1, q~_T / quality_floor)`` (#F,); reference
     :func:`igl_hhj.recovery.recovery_weights`."""
     _threads()
-    return _core.recovery_weights(mesh.V, mesh.F, _i64(mesh.face_edges), _i64(mesh.edge_faces),
+    return _core.recovery_weights(mesh.V, mesh.F, _i32(mesh.face_edges), _i32(mesh.edge_faces),
                                   float(quality_floor))
 
 
@@ -483,7 +506,7 @@ def smooth_vertex_tensors(mesh, X, C, mass, t, steps, coefficients, rtol, maxite
     if C.shape[0] != mesh.n_faces or mass.shape != (mesh.n_vertices,):
         raise ValueError("smooth_vertex_tensors: C must be (#F, 3) and mass (#V,)")
     _threads()
-    return _core.smooth_vertex_tensors(_i64(mesh.edges), _i64(mesh.edge_faces), _i64(mesh.edge_local_index),
+    return _core.smooth_vertex_tensors(_i32(mesh.edges), _i32(mesh.edge_faces), _i8(mesh.edge_local_index),
                                        C, mass, X, float(t), int(steps), [float(c) for c in coefficients],
                                        float(rtol), int(maxiter))
 
@@ -503,7 +526,7 @@ def intrinsic_patch_recovery(mesh, S, N, w):
 def vertex_components(mesh):
     """Connected components of the vertex graph: ``(labels (#V,) int32, count)``, labelled in
     the order of their smallest vertex; vertices of no edge get label 0."""
-    return _core.vertex_components(_i64(mesh.edges), int(mesh.n_vertices))
+    return _core.vertex_components(_i32(mesh.edges), int(mesh.n_vertices))
 
 
 def transport_phases(mesh, N):
@@ -513,7 +536,7 @@ def transport_phases(mesh, N):
     if N.shape[0] != mesh.n_vertices:
         raise ValueError("transport_phases: N must be (#V, 3)")
     _threads()
-    return _core.transport_phases(N, _i64(mesh.edges))
+    return _core.transport_phases(N, _i32(mesh.edges))
 
 
 def boundary_normal_fits(mesh, verts, rings, N0):
@@ -530,7 +553,7 @@ def boundary_normal_fits(mesh, verts, rings, N0):
     if int(rings) < 1:
         raise ValueError(f"boundary_normal_fits: rings must be >= 1, got {rings}")
     _threads()
-    return _core.boundary_normal_fits(mesh.V, _i64(mesh.edges), verts, int(rings), N0)
+    return _core.boundary_normal_fits(mesh.V, _i32(mesh.edges), verts, int(rings), N0)
 
 
 def adaptive_radius(mesh, pilot, rough, radius, gain, power, lo, hi):
@@ -572,8 +595,8 @@ def intrinsic_smoothing(mesh, X, C, mass, phase, rough, radius, *, per_radius, p
             or rough.shape != (mesh.n_vertices,):
         raise ValueError("intrinsic_smoothing: C must be (#F, 3), mass and rough (#V,), phase (#E, 2)")
     _threads()
-    return _core.intrinsic_smoothing(mesh.V, mesh.F, _i64(mesh.edges), _i64(mesh.edge_faces),
-                                     _i64(mesh.edge_local_index), C, mass, phase, rough, X, float(radius),
+    return _core.intrinsic_smoothing(mesh.V, mesh.F, _i32(mesh.edges), _i32(mesh.edge_faces),
+                                     _i8(mesh.edge_local_index), C, mass, phase, rough, X, float(radius),
                                      float(per_radius), float(pilot_radius), float(pilot_rtol), float(gain),
                                      float(power), float(bounds[0]), float(bounds[1]), int(steps),
                                      [float(c) for c in coefficients], float(rtol), int(maxiter))

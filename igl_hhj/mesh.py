@@ -40,6 +40,13 @@ Numerical-robustness policy (one set of limits for every solver)
   they are listed in ``bad_vertices`` (:func:`mark_bad_vertices`).
 * :class:`TriangleMesh` holds read-only copies of ``V`` and ``F``: the arrays
   cannot change after validation.
+* The topology maps are narrow (memory at the solve, issue 25): edge, face and
+  vertex indices in them are int32 (``edges``, ``face_edges``, ``edge_faces``), local
+  indices, signs and counts int8 (``edge_local_index``, ``face_edge_sign``,
+  ``edge_face_count``).  Indexing, ``np.bincount`` and scipy.sparse take them as they
+  are; cast to int64 before arithmetic that can exceed 2³¹ (``3 * f + i``,
+  ``edges[:, 0] * #V``).  A mesh needs fewer than 2³¹ vertices, faces and unique
+  edges (else ``ValueError``).
 """
 from __future__ import annotations
 
@@ -296,29 +303,33 @@ class TriangleMesh:
 
     @cached_property
     def edges(self):
-        """(#E, 2) int64: unique undirected edges as ``(min, max)`` vertex pairs, in
-        lexicographic order (the order of ``uE`` of ``igl.unique_edge_map``)."""
+        """(#E, 2) int32: unique undirected edges as ``(min, max)`` vertex pairs, in
+        lexicographic order (the order of ``uE`` of ``igl.unique_edge_map``).  int32 for
+        memory: cast to int64 before arithmetic on the indices (module docstring)."""
         return self._topology[0]
 
     @cached_property
     def face_edges(self):
-        """(#F, 3) int64: ``face_edges[f, i]`` = unique edge opposite corner ``i`` of face ``f``."""
+        """(#F, 3) int32: ``face_edges[f, i]`` = unique edge opposite corner ``i`` of face ``f``."""
         return self._topology[1]
 
     @cached_property
     def edge_face_count(self):
-        """(#E,) int64: number of faces incident to each unique edge (1 = boundary)."""
+        """(#E,) int8: number of faces incident to each unique edge (1 = boundary),
+        saturated at 127 (only 1, 2 and more than 2 matter: a mesh with more than two
+        faces at an edge is rejected)."""
         return self._topology[2]
 
     @cached_property
     def face_edge_sign(self):
-        """(#F, 3) float64: +1 where the half-edge ``x_{i+1} → x_{i+2}`` of face f
-        runs in the direction of the unique edge ``edges[face_edges[f, i]]``, else -1."""
+        """(#F, 3) int8: +1 where the half-edge ``x_{i+1} → x_{i+2}`` of face f
+        runs in the direction of the unique edge ``edges[face_edges[f, i]]``, else -1
+        (a float64 array times it: float64, the same bits as with a ±1.0 factor)."""
         return self._topology[5]
 
     @cached_property
     def edge_faces(self):
-        """(#E, 2) int64: the faces on either side of each edge, -1 for none.
+        """(#E, 2) int32: the faces on either side of each edge, -1 for none.
 
         Column 0 holds the face in which the edge is positively oriented
         (``face_edge_sign == +1``), column 1 the other one."""
@@ -326,7 +337,7 @@ class TriangleMesh:
 
     @cached_property
     def edge_local_index(self):
-        """(#E, 2) int64: local index (0..2) of the edge inside each face of ``edge_faces``; -1 for none."""
+        """(#E, 2) int8: local index (0..2) of the edge inside each face of ``edge_faces``; -1 for none."""
         return self._topology[4]
 
     @cached_property
@@ -539,7 +550,8 @@ class TriangleMesh:
             e = int(np.flatnonzero(bad)[0])
             raise MeshDefectError(
                 f"mesh has non-manifold edges (more than two incident faces); first is edge "
-                f"{e} between vertices {self.edges[e].tolist()} with {int(count[e])} faces",
+                f"{e} between vertices {self.edges[e].tolist()} with "
+                f"{int(np.count_nonzero(self.face_edges == e))} faces",      # count saturates at 127
                 "non-manifold")
         # On a consistently oriented manifold every interior edge is traversed
         # once in each direction.
@@ -653,7 +665,8 @@ def topology_reference(F):
     ``c`` of face ``f``; edges are re-oriented as ``(min, max)``.
 
     Returns ``(edges, face_edges, count, edge_faces, edge_local_index, face_edge_sign)``
-    as :func:`igl_hhj.kernels.topology`.
+    as :func:`igl_hhj.kernels.topology` (int32 indices, int8 counts, local indices and
+    signs; libigl's int64 outputs are converted once here).
     """
     import igl
     F = np.ascontiguousarray(F, dtype=np.int64)
@@ -661,13 +674,13 @@ def topology_reference(F):
     _, uE, EMAP, uEC, _ = igl.unique_edge_map(F)
     edges = np.sort(np.asarray(uE, dtype=np.int64), axis=1)
     face_edges = np.ascontiguousarray(np.asarray(EMAP).reshape(3, nF).T)
-    count = np.diff(uEC)
+    count = np.minimum(np.diff(uEC), 127).astype(np.int8)
     src = F[:, [1, 2, 0]]
-    sign = np.where(edges[face_edges, 0] == src, 1.0, -1.0)
+    sign = np.where(edges[face_edges, 0] == src, 1, -1).astype(np.int8)
     nE = edges.shape[0]
-    ef = -np.ones((nE, 2), dtype=np.int64)
-    li = -np.ones((nE, 2), dtype=np.int64)
+    ef = -np.ones((nE, 2), dtype=np.int32)
+    li = -np.ones((nE, 2), dtype=np.int8)
     col = (sign.ravel() < 0).astype(np.int64)
     ef[face_edges.ravel(), col] = np.repeat(np.arange(nF), 3)
     li[face_edges.ravel(), col] = np.tile(np.arange(3), nF)
-    return edges, face_edges, count, ef, li, sign
+    return edges.astype(np.int32), face_edges.astype(np.int32), count, ef, li, sign

@@ -440,6 +440,30 @@ def test_fused_jacobi_pcg_equals_csr_preconditioner(closed):
     assert a[1] == b[1] and a[2] == b[2] == 0 and np.array_equal(a[0], b[0])
 
 
+def test_block_pcg_int32_and_int64_row_pointers_give_the_same_bits(closed, monkeypatch):
+    """The HHJ system's fixed-width row pointer is int32 (memory at the solve): the PCG runs
+    on it uncopied, with the operations of the int64 path; mixed types take the int64 one."""
+    import igl
+    K = sp.csr_matrix(-igl.cotmatrix(closed.V, closed.F) + sp.diags(np.full(closed.n_vertices, 1e-2)))
+    K.sort_indices()
+    R = np.random.default_rng(3).normal(size=(K.shape[0], 3))
+    D = sp.diags(1.0 / K.diagonal()).tocsr()
+    kw = dict(rtol=1e-10, maxiter=2000)
+    p32, p64 = K.indptr.astype(np.int32), K.indptr.astype(np.int64)
+    d32, d64 = D.indptr.astype(np.int32), D.indptr.astype(np.int64)
+    calls = []
+    for name in ("block_pcg", "block_pcg32"):
+        f = getattr(kernels._core, name)
+        monkeypatch.setattr(kernels._core, name, lambda *a, _f=f, _n=name: calls.append((_n, a[0])) or _f(*a))
+    runs = [kernels.block_pcg(p, K.indices, K.data, R, M=(d, D.indices, D.data), **kw)
+            for p, d in ((p32, d32), (p64, d64), (p32, d64))]
+    assert [c[0] for c in calls] == ["block_pcg32", "block_pcg", "block_pcg"]
+    assert calls[0][1] is p32                          # no copy of an int32 row pointer
+    for r in runs[1:]:
+        assert r[1] == runs[0][1] and r[2] == 0 and np.array_equal(r[0], runs[0][0])
+    assert kernels.ell_indptr(10).dtype == np.int32 and kernels.ell_indptr(2**29).dtype == np.int64
+
+
 def test_vertex_stage_bit_identical_across_thread_counts():
     from igl_hhj import recovery as rc
     m = TriangleMesh(*_bumpy(5))
@@ -694,6 +718,31 @@ def test_topology_refuses_sizes_beyond_its_32_bit_keys():
     vertices (or 1.43e9 faces) is a ValueError, not a wrong answer."""
     with pytest.raises(ValueError, match="at most"):
         kernels.topology(np.array([[0, 1, 2]]), 2 ** 32)
+
+
+def test_topology_refuses_sizes_beyond_its_int32_maps():
+    """The maps hold int32 indices: 2**31 vertices or faces are a ValueError before any
+    work (the face array is a broadcast view: no 2**31 x 3 array is made)."""
+    with pytest.raises(ValueError, match="at most 2\\*\\*31 - 1 vertices, faces"):
+        kernels.topology(np.array([[0, 1, 2]]), 2 ** 31)
+    with pytest.raises(ValueError, match="at most 2\\*\\*31 - 1 vertices, faces"):
+        kernels.topology(np.broadcast_to(np.array([[0, 1, 2]]), (2 ** 31, 3)), 3)
+    with pytest.raises(ValueError, match="2\\*\\*31 - 1 vertices"):     # the binding's own check
+        kernels._core.topology(np.array([[0, 1, 2]]), 2 ** 31)
+
+
+def test_topology_count_saturates_and_the_error_names_the_true_count():
+    """edge_face_count is int8, saturated at 127: an edge of 200 faces stays non-manifold
+    (not 200 mod 256 = 72 -> 'fine'), and the error counts the faces exactly."""
+    k = 200
+    a = np.linspace(0, 2 * np.pi, k, endpoint=False)
+    V = np.r_[[[0.0, 0, 0], [0, 0, 1]], np.c_[np.cos(a), np.sin(a), np.full(k, 0.5)]]
+    F = np.c_[np.zeros(k, int), np.ones(k, int), 2 + np.arange(k)]
+    count = kernels.topology(F, len(V))[2]
+    assert count.dtype == np.int8 and count.max() == 127
+    assert np.array_equal(count, topology_reference(F)[2])
+    with pytest.raises(ValueError, match=f"non-manifold.*with {k} faces"):
+        TriangleMesh(V, F)
 
 
 # --- large-call heap scope (igl_hhj/_core/heap.cpp) -------------------------------------

@@ -5,21 +5,26 @@ the assembled system are alive while the compiled PCG holds its work vectors.  T
 is the bytes of the distinct arrays alive at the solve (arrays sharing memory with the
 input do not count: the drop-in's mesh views ``V`` and ``F``) plus the PCG's work set,
 per face; the resident peak measured by ``python -m igl_hhj.benchmarks.speed`` tracks it
-(0.52 KB/face on the 328k jittered ellipsoid).
+(0.425 KB/face on the jittered icosphere(7), 327,680 faces; 0.511 with int64 topology maps).
 """
+from functools import cached_property
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
 import igl_hhj
-from igl_hhj import solvers
-from igl_hhj.mesh import as_mesh
+from igl_hhj import kernels, solvers
+from igl_hhj.mesh import TriangleMesh, as_mesh
 from igl_hhj.surfaces import Sphere, icosphere, jitter_tangentially
 
-# KB/face above the input at the solve on this mesh: 0.504; 0.562 before the views of V, F
-# (36 B/face), the int32 Morton permutations (12 B/face) and the release of the face cross
-# products (24 B/face).  The issue's target is 0.45 (not reached).
-SOLVE_BUDGET_KB_PER_FACE = 0.51
+# KB/face above the input at the solve on this mesh: 0.412; 0.418 with the int64 ELL row
+# pointer (6 B/face), 0.504 with int64 topology maps too (int32 edges / face_edges /
+# edge_faces, int8 local indices, signs and counts: 88.5 B/face less), 0.562 before the
+# views of V, F (36 B/face), the int32 Morton permutations (12 B/face) and the release of
+# the face cross products (24 B/face).  The issue's target, a resident peak of 0.45
+# KB/face, is reached on icosphere(7) and its jittered version (docs/speed.md).
+SOLVE_BUDGET_KB_PER_FACE = 0.42
 # compiled block PCG on k right-hand sides (pcg.cpp): R (the caller's rhs, overwritten),
 # X, z, p, q, each (#E, k) float64
 PCG_WORK_ARRAYS = 5
@@ -71,6 +76,38 @@ def test_dropin_memory_at_the_solve_within_budget(monkeypatch):
     V, F = _ellipsoid(6)                       # 81,920 faces
     kb = _solve_kb_per_face(monkeypatch, V, F)
     assert kb <= SOLVE_BUDGET_KB_PER_FACE, f"{kb:.3f} KB/face alive at the solve"
+
+
+def _wide_topology(self):
+    """The topology maps as they were before issue 25 item 5: int64, float64 signs."""
+    maps = kernels.topology(self.F, self.n_vertices)
+    return tuple(a.astype(np.float64 if k == 5 else np.int64) for k, a in enumerate(maps))
+
+
+def test_memory_budget_fails_with_int64_topology_maps(monkeypatch):
+    # the budget can fail: with the maps widened back to int64 (float64 signs) the
+    # proxy grows by their 88.5 B/face and exceeds it
+    V, F = _ellipsoid(6)
+    narrow = _solve_kb_per_face(monkeypatch, V, F)
+    wide = cached_property(_wide_topology)
+    wide.__set_name__(TriangleMesh, "_topology")
+    monkeypatch.setattr(TriangleMesh, "_topology", wide)
+    widened = _solve_kb_per_face(monkeypatch, V, F)
+    nE = 3 * len(F) // 2                       # closed mesh
+    assert (widened - narrow) * 1024 * len(F) == pytest.approx(
+        len(F) * 3 * (8 - 4) + len(F) * 3 * (8 - 1) + nE * 2 * (8 - 4) * 2 + nE * 2 * (8 - 1) + nE * (8 - 1))
+    assert widened > SOLVE_BUDGET_KB_PER_FACE >= narrow
+
+
+def test_topology_maps_are_narrow_and_reach_the_kernels_uncopied():
+    m = TriangleMesh(*_ellipsoid(2))
+    assert m.edges.dtype == m.face_edges.dtype == m.edge_faces.dtype == np.int32
+    assert m.edge_local_index.dtype == m.face_edge_sign.dtype == m.edge_face_count.dtype == np.int8
+    # the wrappers' coercions are no-ops on the stored maps (no per-call int64 copies)
+    for a in (m.edges, m.face_edges, m.edge_faces):
+        assert kernels._i32(a) is a
+    for a in (m.edge_local_index,):
+        assert kernels._i8(a) is a
 
 
 def test_memory_proxy_counts_a_copy_of_the_input(monkeypatch):

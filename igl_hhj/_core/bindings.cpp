@@ -1,4 +1,5 @@
-// The only file that knows nanobind: ndarrays in (C-contiguous float64 / int64,
+// The only file that knows nanobind: ndarrays in (C-contiguous float64 / int64, the
+// topology maps int32 / int8 as TriangleMesh stores them,
 // shapes checked in igl_hhj/kernels.py and again here where an index could go
 // out of bounds), ndarrays out (owned by Python), the GIL released around work.
 #include <nanobind/nanobind.h>
@@ -14,6 +15,8 @@
 namespace nb = nanobind;
 using namespace nb::literals;
 using hhj::i64;
+using hhj::i32;
+using hhj::i8;
 
 template <class T>
 using In = nb::ndarray<const T, nb::c_contig, nb::device::cpu>;
@@ -29,6 +32,94 @@ static Out<T> to_numpy(std::vector<T>&& v, std::initializer_list<size_t> shape) 
 
 static void need(bool ok, const char* what) {
     if (!ok) throw std::invalid_argument(what);
+}
+
+// block_pcg of the module, for either row-pointer type I of A and M
+template <class I>
+static nb::tuple block_pcg_py(In<I> Ap, In<std::int32_t> Ai, In<double> Ax, std::optional<In<I>> Mp,
+                              std::optional<In<std::int32_t>> Mi, std::optional<In<double>> Mx,
+                              std::optional<In<double>> dinv, nb::ndarray<double, nb::c_contig, nb::device::cpu> R,
+                              double rtol, i64 maxiter,
+                              i64 probe_iter, double max_predicted, std::optional<In<i64>> S,
+                              std::optional<nb::callable> subdomain_solve, std::optional<nb::tuple> subdomain_ldl,
+                              bool coupled) {
+    need(R.ndim() == 2, "block_pcg: R must be (n, k)");
+    const i64 n = R.shape(0);
+    const int k = (int)R.shape(1);
+    need(Ap.shape(0) == (size_t)n + 1, "block_pcg: indptr must have n + 1 entries");
+    need(Mp.has_value() || (dinv.has_value() && dinv->shape(0) == (size_t)n),
+         "block_pcg: need a preconditioner (CSR) or dinv (n,)");
+    std::vector<double> X((size_t)n * k);
+    hhj::PCGResult res;
+    hhj::SubdomainSolve sub;
+    if (S && (subdomain_ldl || subdomain_solve)) {
+        sub.S = S->data();
+        sub.nS = (i64)S->shape(0);
+        for (i64 i = 0; i < sub.nS; ++i) need(sub.S[i] >= 0 && sub.S[i] < n, "block_pcg: S index out of range");
+    }
+    // keeps the factor's arrays alive for the native solve below
+    std::optional<In<i64>> Lp, Li, perm;
+    std::optional<In<double>> Lx, D;
+    if (S && subdomain_ldl) {
+        need(subdomain_ldl->size() == 5, "block_pcg: subdomain_ldl must be (Lp, Li, Lx, D, perm)");
+        Lp = nb::cast<In<i64>>((*subdomain_ldl)[0]);
+        Li = nb::cast<In<i64>>((*subdomain_ldl)[1]);
+        Lx = nb::cast<In<double>>((*subdomain_ldl)[2]);
+        D = nb::cast<In<double>>((*subdomain_ldl)[3]);
+        perm = nb::cast<In<i64>>((*subdomain_ldl)[4]);
+        const i64 nS = sub.nS;
+        need(Lp->ndim() == 1 && Lp->shape(0) == (size_t)nS + 1 && D->shape(0) == (size_t)nS &&
+             perm->shape(0) == (size_t)nS && Li->shape(0) == Lx->shape(0),
+             "block_pcg: subdomain_ldl shapes do not match S");
+        const i64* lp = Lp->data();
+        need(lp[0] == 0 && lp[nS] == (i64)Li->shape(0), "block_pcg: subdomain_ldl Lp");
+        for (i64 j = 0; j < nS; ++j) {
+            need(lp[j] <= lp[j + 1], "block_pcg: subdomain_ldl Lp not monotone");
+            for (i64 q = lp[j]; q < lp[j + 1]; ++q)
+                need(Li->data()[q] > j && Li->data()[q] < nS, "block_pcg: subdomain_ldl L not strictly lower");
+        }
+        std::vector<unsigned char> seen(nS, 0);
+        for (i64 i = 0; i < nS; ++i) {
+            const i64 o = perm->data()[i];
+            need(o >= 0 && o < nS && !seen[o], "block_pcg: subdomain_ldl perm is not a permutation");
+            seen[o] = 1;
+        }
+        hhj::LDLFactor f;
+        f.n = nS;
+        f.Lp = lp;
+        f.Li = Li->data();
+        f.Lx = Lx->data();
+        f.D = D->data();
+        f.perm = perm->data();
+        hhj::ldl_schedule(f);
+        auto work = std::make_shared<std::vector<double>>((size_t)nS * k);
+        auto fac = std::make_shared<const hhj::LDLFactor>(std::move(f));
+        sub.solve = [fac, work, k](const double* rS, double* zS, int nt) {
+            hhj::ldl_solve_block(*fac, k, rS, zS, work->data(), nt);
+        };
+    } else if (S && subdomain_solve) {
+        const size_t nS = sub.nS, kk = k;
+        nb::callable fn = *subdomain_solve;
+        sub.solve = [fn, nS, kk](const double* rS, double* zS, int) {
+            nb::gil_scoped_acquire gil;
+            // rS is a scratch buffer: writable, so that solvers taking writable input accept it
+            nb::ndarray<nb::numpy, double> a(const_cast<double*>(rS), {nS, kk});
+            nb::ndarray<nb::numpy, double> b(zS, {nS, kk});
+            // reference policy: the callee writes into zS itself (no copies)
+            fn(nb::cast(a, nb::rv_policy::reference), nb::cast(b, nb::rv_policy::reference));
+        };
+    }
+    {
+        nb::gil_scoped_release nogil;
+        hhj::ThreadBudget tb(n * k, hhj::PCG_MIN_WORK);
+        res = hhj::block_pcg(n, k, Ap.data(), Ai.data(), Ax.data(),
+                             Mp ? Mp->data() : nullptr, Mp ? Mi->data() : nullptr,
+                             Mp ? Mx->data() : nullptr, dinv ? dinv->data() : nullptr,
+                             R.data(), X.data(), rtol, maxiter, probe_iter, max_predicted, tb.nt,
+                             sub.nS ? &sub : nullptr, coupled);
+    }
+    return nb::make_tuple(to_numpy(std::move(X), {(size_t)n, (size_t)k}), res.iterations, res.status,
+                          res.relres);
 }
 
 NB_MODULE(_hhj_core, m) {
@@ -68,8 +159,8 @@ NB_MODULE(_hhj_core, m) {
     m.def("topology", [](In<i64> F, i64 nV) {
         need(F.ndim() == 2 && F.shape(1) == 3, "F must be (#F, 3)");
         const i64 nF = F.shape(0);
-        need(3 * nF < ((i64)1 << 32) && nV < ((i64)1 << 32),
-             "topology: at most 1 431 655 765 faces and 2**32 - 1 vertices");
+        need(3 * nF < ((i64)1 << 32) && nV < ((i64)1 << 31),
+             "topology: at most 1 431 655 765 faces and 2**31 - 1 vertices (int32 edge maps)");
         hhj::Topology T;
         {
             nb::gil_scoped_release nogil;
@@ -114,7 +205,7 @@ NB_MODULE(_hhj_core, m) {
         return nb::make_tuple(to_numpy(std::move(s), {(size_t)nV, 3}), to_numpy(std::move(a), {(size_t)nV}));
     });
 
-    m.def("edge_morton_order", [](In<double> V, In<i64> E) {
+    m.def("edge_morton_order", [](In<double> V, In<i32> E) {
         need(V.ndim() == 2 && V.shape(1) == 3 && E.ndim() == 2 && E.shape(1) == 2, "edge_morton_order: shapes");
         const i64 nE = E.shape(0);
         std::vector<i64> perm(nE);
@@ -126,7 +217,7 @@ NB_MODULE(_hhj_core, m) {
         return to_numpy(std::move(perm), {(size_t)nE});
     });
 
-    m.def("hhj_system", [](In<double> V, In<i64> F, In<i64> FE, In<i64> EF, In<i64> ELI,
+    m.def("hhj_system", [](In<double> V, In<i64> F, In<i32> FE, In<i32> EF, In<i8> ELI,
                            std::optional<In<unsigned char>> fixed, bool schwarz) {
         const i64 nF = F.shape(0), nE = EF.shape(0);
         need(FE.shape(0) == (size_t)nF && ELI.shape(0) == (size_t)nE, "hhj_system: inconsistent shapes");
@@ -158,7 +249,7 @@ NB_MODULE(_hhj_core, m) {
                               Mout, n_jacobi, to_numpy(std::move(sin_min), {(size_t)nF}));
     }, "V"_a, "F"_a, "FE"_a, "EF"_a, "ELI"_a, "fixed"_a.none(), "schwarz"_a);
 
-    m.def("jump_apply", [](In<double> V, In<i64> F, In<i64> EF, In<i64> ELI, In<double> W) {
+    m.def("jump_apply", [](In<double> V, In<i64> F, In<i32> EF, In<i8> ELI, In<double> W) {
         const i64 nF = F.shape(0), nE = EF.shape(0);
         need(W.ndim() == 2 && W.shape(0) == V.shape(0), "jump_apply: W must be (#V, k)");
         const int k = (int)W.shape(1);
@@ -171,91 +262,9 @@ NB_MODULE(_hhj_core, m) {
         return to_numpy(std::move(out), {(size_t)nE, (size_t)k});
     });
 
-    m.def("block_pcg", [](In<i64> Ap, In<std::int32_t> Ai, In<double> Ax, std::optional<In<i64>> Mp,
-                          std::optional<In<std::int32_t>> Mi, std::optional<In<double>> Mx,
-                          std::optional<In<double>> dinv, nb::ndarray<double, nb::c_contig, nb::device::cpu> R,
-                          double rtol, i64 maxiter,
-                          i64 probe_iter, double max_predicted, std::optional<In<i64>> S,
-                          std::optional<nb::callable> subdomain_solve, std::optional<nb::tuple> subdomain_ldl,
-                          bool coupled) {
-        need(R.ndim() == 2, "block_pcg: R must be (n, k)");
-        const i64 n = R.shape(0);
-        const int k = (int)R.shape(1);
-        need(Ap.shape(0) == (size_t)n + 1, "block_pcg: indptr must have n + 1 entries");
-        need(Mp.has_value() || (dinv.has_value() && dinv->shape(0) == (size_t)n),
-             "block_pcg: need a preconditioner (CSR) or dinv (n,)");
-        std::vector<double> X((size_t)n * k);
-        hhj::PCGResult res;
-        hhj::SubdomainSolve sub;
-        if (S && (subdomain_ldl || subdomain_solve)) {
-            sub.S = S->data();
-            sub.nS = (i64)S->shape(0);
-            for (i64 i = 0; i < sub.nS; ++i) need(sub.S[i] >= 0 && sub.S[i] < n, "block_pcg: S index out of range");
-        }
-        // keeps the factor's arrays alive for the native solve below
-        std::optional<In<i64>> Lp, Li, perm;
-        std::optional<In<double>> Lx, D;
-        if (S && subdomain_ldl) {
-            need(subdomain_ldl->size() == 5, "block_pcg: subdomain_ldl must be (Lp, Li, Lx, D, perm)");
-            Lp = nb::cast<In<i64>>((*subdomain_ldl)[0]);
-            Li = nb::cast<In<i64>>((*subdomain_ldl)[1]);
-            Lx = nb::cast<In<double>>((*subdomain_ldl)[2]);
-            D = nb::cast<In<double>>((*subdomain_ldl)[3]);
-            perm = nb::cast<In<i64>>((*subdomain_ldl)[4]);
-            const i64 nS = sub.nS;
-            need(Lp->ndim() == 1 && Lp->shape(0) == (size_t)nS + 1 && D->shape(0) == (size_t)nS &&
-                 perm->shape(0) == (size_t)nS && Li->shape(0) == Lx->shape(0),
-                 "block_pcg: subdomain_ldl shapes do not match S");
-            const i64* lp = Lp->data();
-            need(lp[0] == 0 && lp[nS] == (i64)Li->shape(0), "block_pcg: subdomain_ldl Lp");
-            for (i64 j = 0; j < nS; ++j) {
-                need(lp[j] <= lp[j + 1], "block_pcg: subdomain_ldl Lp not monotone");
-                for (i64 q = lp[j]; q < lp[j + 1]; ++q)
-                    need(Li->data()[q] > j && Li->data()[q] < nS, "block_pcg: subdomain_ldl L not strictly lower");
-            }
-            std::vector<unsigned char> seen(nS, 0);
-            for (i64 i = 0; i < nS; ++i) {
-                const i64 o = perm->data()[i];
-                need(o >= 0 && o < nS && !seen[o], "block_pcg: subdomain_ldl perm is not a permutation");
-                seen[o] = 1;
-            }
-            hhj::LDLFactor f;
-            f.n = nS;
-            f.Lp = lp;
-            f.Li = Li->data();
-            f.Lx = Lx->data();
-            f.D = D->data();
-            f.perm = perm->data();
-            hhj::ldl_schedule(f);
-            auto work = std::make_shared<std::vector<double>>((size_t)nS * k);
-            auto fac = std::make_shared<const hhj::LDLFactor>(std::move(f));
-            sub.solve = [fac, work, k](const double* rS, double* zS, int nt) {
-                hhj::ldl_solve_block(*fac, k, rS, zS, work->data(), nt);
-            };
-        } else if (S && subdomain_solve) {
-            const size_t nS = sub.nS, kk = k;
-            nb::callable fn = *subdomain_solve;
-            sub.solve = [fn, nS, kk](const double* rS, double* zS, int) {
-                nb::gil_scoped_acquire gil;
-                // rS is a scratch buffer: writable, so that solvers taking writable input accept it
-                nb::ndarray<nb::numpy, double> a(const_cast<double*>(rS), {nS, kk});
-                nb::ndarray<nb::numpy, double> b(zS, {nS, kk});
-                // reference policy: the callee writes into zS itself (no copies)
-                fn(nb::cast(a, nb::rv_policy::reference), nb::cast(b, nb::rv_policy::reference));
-            };
-        }
-        {
-            nb::gil_scoped_release nogil;
-            hhj::ThreadBudget tb(n * k, hhj::PCG_MIN_WORK);
-            res = hhj::block_pcg(n, k, Ap.data(), Ai.data(), Ax.data(),
-                                 Mp ? Mp->data() : nullptr, Mp ? Mi->data() : nullptr,
-                                 Mp ? Mx->data() : nullptr, dinv ? dinv->data() : nullptr,
-                                 R.data(), X.data(), rtol, maxiter, probe_iter, max_predicted, tb.nt,
-                                 sub.nS ? &sub : nullptr, coupled);
-        }
-        return nb::make_tuple(to_numpy(std::move(X), {(size_t)n, (size_t)k}), res.iterations, res.status,
-                              res.relres);
-    });
+    // int64 row pointers (scipy matrices) and int32 ones (the HHJ system: memory)
+    m.def("block_pcg", &block_pcg_py<i64>);
+    m.def("block_pcg32", &block_pcg_py<i32>);
 
     m.def("envelope_ldl_solve", [](In<i64> Ap, In<std::int32_t> Ai, In<double> Ax, In<double> R,
                                    double resid_rtol) {
@@ -274,7 +283,7 @@ NB_MODULE(_hhj_core, m) {
         return nb::make_tuple(to_numpy(std::move(X), {(size_t)n, (size_t)k}), status);
     });
 
-    m.def("shape_operator_faces", [](In<double> V, In<i64> F, In<i64> FE, In<double> s) {
+    m.def("shape_operator_faces", [](In<double> V, In<i64> F, In<i32> FE, In<double> s) {
         const i64 nF = F.shape(0);
         need(s.ndim() == 2 && s.shape(1) == 3, "shape_operator_faces: s must be (#E, 3)");
         std::vector<double> S((size_t)nF * 9);
@@ -286,7 +295,7 @@ NB_MODULE(_hhj_core, m) {
         return to_numpy(std::move(S), {(size_t)nF, 3, 3});
     });
 
-    m.def("face_tensors", [](In<double> V, In<i64> F, In<i64> FE, In<double> s) {
+    m.def("face_tensors", [](In<double> V, In<i64> F, In<i32> FE, In<double> s) {
         const i64 nF = F.shape(0);
         need(s.ndim() == 2, "face_tensors: s must be (#E, k)");
         const int k = (int)s.shape(1);
@@ -325,7 +334,7 @@ NB_MODULE(_hhj_core, m) {
                               to_numpy(std::move(PV1), {nn}), to_numpy(std::move(PV2), {nn}));
     });
 
-    m.def("recovery_weights", [](In<double> V, In<i64> F, In<i64> FE, In<i64> EF, double floor) {
+    m.def("recovery_weights", [](In<double> V, In<i64> F, In<i32> FE, In<i32> EF, double floor) {
         const i64 nF = F.shape(0), nE = EF.shape(0);
         need(FE.shape(0) == (size_t)nF && FE.shape(1) == 3 && EF.ndim() == 2 && EF.shape(1) == 2,
              "recovery_weights: shapes");
@@ -364,7 +373,7 @@ NB_MODULE(_hhj_core, m) {
         hhj::tangent_projection6(X.data(), N.data(), ref.data(), n, keep_trace, tb.nt);
     });
 
-    m.def("smooth_vertex_tensors", [](In<i64> E, In<i64> EF, In<i64> ELI, In<double> C, In<double> mass,
+    m.def("smooth_vertex_tensors", [](In<i32> E, In<i32> EF, In<i8> ELI, In<double> C, In<double> mass,
                                       nb::ndarray<double, nb::c_contig, nb::device::cpu> X, double t, int steps,
                                       std::vector<double> binom, double rtol, i64 maxiter) {
         const i64 nV = X.shape(0), nE = E.shape(0);
@@ -373,7 +382,7 @@ NB_MODULE(_hhj_core, m) {
              "smooth_vertex_tensors: topology shapes");
         need(nV < ((i64)1 << 31), "smooth_vertex_tensors: at most 2**31 - 1 vertices");
         const i64 nF = C.shape(0);
-        const i64* e = E.data();
+        const i32* e = E.data();
         for (i64 q = 0; q < 2 * nE; ++q) need(e[q] >= 0 && e[q] < nV, "smooth_vertex_tensors: edge index out of range");
         for (i64 q = 0; q < 2 * nE; ++q)
             need(EF.data()[q] < nF && ELI.data()[q] < 3, "smooth_vertex_tensors: edge_faces out of range");
@@ -403,7 +412,7 @@ NB_MODULE(_hhj_core, m) {
         return nb::make_tuple(to_numpy(std::move(X), {(size_t)nV, 3}), to_numpy(std::move(rough), {(size_t)nV}));
     });
 
-    m.def("vertex_components", [](In<i64> E, i64 nV) {
+    m.def("vertex_components", [](In<i32> E, i64 nV) {
         need(E.ndim() == 2 && E.shape(1) == 2, "vertex_components: E must be (#E, 2)");
         const i64 nE = E.shape(0);
         for (i64 q = 0; q < 2 * nE; ++q) need(E.data()[q] >= 0 && E.data()[q] < nV, "vertex_components: index out of range");
@@ -416,7 +425,7 @@ NB_MODULE(_hhj_core, m) {
         return nb::make_tuple(to_numpy(std::move(label), {(size_t)nV}), n);
     });
 
-    m.def("transport_phases", [](In<double> N, In<i64> E) {
+    m.def("transport_phases", [](In<double> N, In<i32> E) {
         const i64 nV = N.shape(0), nE = E.shape(0);
         need(N.ndim() == 2 && N.shape(1) == 3 && E.ndim() == 2 && E.shape(1) == 2, "transport_phases: shapes");
         for (i64 q = 0; q < 2 * nE; ++q) need(E.data()[q] >= 0 && E.data()[q] < nV, "transport_phases: index out of range");
@@ -429,7 +438,7 @@ NB_MODULE(_hhj_core, m) {
         return to_numpy(std::move(ph), {(size_t)nE, 2});
     });
 
-    m.def("boundary_normal_fits", [](In<double> X, In<i64> E, In<i64> verts, int rings, In<double> N0) {
+    m.def("boundary_normal_fits", [](In<double> X, In<i32> E, In<i64> verts, int rings, In<double> N0) {
         const i64 nV = X.shape(0), nE = E.shape(0), n = verts.shape(0);
         need(X.shape(1) == 3 && E.shape(1) == 2 && N0.shape(0) == (size_t)n && N0.shape(1) == 3,
              "boundary_normal_fits: shapes");
@@ -459,7 +468,7 @@ NB_MODULE(_hhj_core, m) {
         return to_numpy(std::move(r), {(size_t)nF});
     });
 
-    m.def("intrinsic_smoothing", [](In<double> V, In<i64> F, In<i64> E, In<i64> EF, In<i64> ELI, In<double> C,
+    m.def("intrinsic_smoothing", [](In<double> V, In<i64> F, In<i32> E, In<i32> EF, In<i8> ELI, In<double> C,
                                     In<double> mass, In<double> phase, In<double> rough,
                                     nb::ndarray<double, nb::c_contig, nb::device::cpu> X, double radius,
                                     double per_radius, double pilot_radius, double pilot_rtol, double gain,

@@ -5,7 +5,10 @@
 //   t_i = unit edge vector, nu = unit face normal of (x1-x0)x(x2-x0),
 //   n_i = t_i x nu (outward conormal), grad lambda_i = -l_i n_i / (2|T|).
 // No hidden state: every kernel reads its inputs and writes caller-owned outputs.
-// Arrays are row-major (C-contiguous) float64 / int64.
+// Arrays are row-major (C-contiguous) float64 / int64; the topology maps of
+// mesh.TriangleMesh are narrow (memory, issue 25): edge, face and vertex indices in
+// them int32 (i32), local indices, signs and incidence counts int8 (i8).  Load an
+// i32 into an i64 before multiplying it (3 * e overflows int above 715M).
 #pragma once
 #include <atomic>
 #include <cmath>
@@ -22,6 +25,8 @@
 namespace hhj {
 
 using i64 = std::int64_t;
+using i32 = std::int32_t;
+using i8 = std::int8_t;
 
 // ------------------------------------------------------------------ threads
 // Number of threads a kernel may use.  One call at a time gets all OpenMP
@@ -171,31 +176,31 @@ inline void face_geom(const double* V, const i64* F, i64 f, FaceGeom& g) {
 // ------------------------------------------------------------------ kernels
 // mesh_kernels.cpp
 struct Topology {
-    std::vector<i64> edges;        // (#E, 2) (min, max), lexicographic order (= igl uE order)
-    std::vector<i64> face_edges;   // (#F, 3)
-    std::vector<i64> count;        // (#E,)
-    std::vector<i64> edge_faces;   // (#E, 2), -1 = none
-    std::vector<i64> local_index;  // (#E, 2), -1 = none
-    std::vector<double> sign;      // (#F, 3) +-1
+    std::vector<i32> edges;        // (#E, 2) (min, max), lexicographic order (= igl uE order)
+    std::vector<i32> face_edges;   // (#F, 3)
+    std::vector<i8> count;         // (#E,), saturates at 127 (only 1, 2 and > 2 matter)
+    std::vector<i32> edge_faces;   // (#E, 2), -1 = none
+    std::vector<i8> local_index;   // (#E, 2), -1 = none
+    std::vector<i8> sign;          // (#F, 3) +-1
     i64 n_edges = 0;
 };
 void topology(const i64* F, i64 nF, i64 nV, Topology& out);
-void edge_morton_order(const double* V, i64 nV, const i64* E, i64 nE, i64* perm);
+void edge_morton_order(const double* V, i64 nV, const i32* E, i64 nE, i64* perm);
 void face_metrics(const double* V, const i64* F, i64 nF, double* cross, double* dbl, double* l2max, int nt);
 void vertex_area_sums(const i64* F, i64 nF, i64 nV, const double* cross, const double* dbl, double* s,
                       double* a);
 
 // hhj_kernels.cpp
 void local_mass(const double* V, const i64* F, i64 nF, double* Aloc, double* sin_min = nullptr);
-void assemble_ell(const double* Aloc, const i64* FE, const i64* EF, const i64* ELI, i64 nE,
+void assemble_ell(const double* Aloc, const i32* FE, const i32* EF, const i8* ELI, i64 nE,
                   std::int32_t* cols, double* vals, int nt);
-i64 face_schwarz(const double* Aloc, const double* diag, const i64* FE, const unsigned char* fixed,
+i64 face_schwarz(const double* Aloc, const double* diag, const i32* FE, const unsigned char* fixed,
                  i64 nF, double* inv, int nt);
-void jump_apply(const double* V, const i64* F, i64 nF, const i64* EF, const i64* ELI, i64 nE,
+void jump_apply(const double* V, const i64* F, i64 nF, const i32* EF, const i8* ELI, i64 nE,
                 const double* W, int k, double* out, int nt);
-void shape_operator_faces(const double* V, const i64* F, const i64* FE, i64 nF,
+void shape_operator_faces(const double* V, const i64* F, const i32* FE, i64 nF,
                           const double* s, double* S, int nt);
-void face_tensors(const double* V, const i64* F, const i64* FE, i64 nF,
+void face_tensors(const double* V, const i64* F, const i32* FE, i64 nF,
                   const double* s, int k, double* H, int nt);
 void lumped_vertex_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S,
                             const double* N, double* Sv);
@@ -203,7 +208,7 @@ void principal_2x2(const double* S, const double* N, i64 n, double* PD1, double*
                    double* PV1, double* PV2, int nt);
 
 // recovery_kernels.cpp
-void recovery_weights(const double* V, const i64* F, i64 nF, const i64* FE, const i64* EF, i64 nE,
+void recovery_weights(const double* V, const i64* F, i64 nF, const i32* FE, const i32* EF, i64 nE,
                       double floor, double* w, int nt);
 void patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S, const double* N,
                     const double* w, const unsigned char* ref, double h, double* X, int nt);
@@ -212,30 +217,30 @@ void tangent_projection6(double* X, const double* N, const unsigned char* ref, i
 void intrinsic_patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S,
                               const double* N, const double* w, const unsigned char* ref, double h,
                               double* X, double* rough, int nt);
-void vertex_laplacian(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* ELI, const double* C,
+void vertex_laplacian(i64 nV, const i32* E, i64 nE, const i32* EF, const i8* ELI, const double* C,
                       std::vector<i64>& indptr, std::vector<std::int32_t>& indices,
                       std::vector<double>& L, std::vector<i64>& diag_pos,
                       std::vector<i64>* pos_lo = nullptr, std::vector<i64>* pos_hi = nullptr);
 
-void boundary_normal_fits(const double* X, i64 nV, const i64* E, i64 nE, const i64* verts, i64 n, int rings,
+void boundary_normal_fits(const double* X, i64 nV, const i32* E, i64 nE, const i64* verts, i64 n, int rings,
                           const double* N0, double* N, int nt);
 
 // intrinsic_kernels.cpp
-i64 vertex_groups(i64 nV, const i64* E, i64 nE, std::vector<std::int32_t>& label);
-void transport_phases(const double* N, i64 nV, const i64* E, i64 nE, double* phase, int nt);
+i64 vertex_groups(i64 nV, const i32* E, i64 nE, std::vector<std::int32_t>& label);
+void transport_phases(const double* N, i64 nV, const i32* E, i64 nE, double* phase, int nt);
 void adaptive_radius(const double* V, const i64* F, i64 nF, i64 nV, const double* P, const double* rough,
                      double radius, double gain, double power, double lo, double hi, double* r, int nt);
 void face_times(const double* V, const i64* F, i64 nF, const double* r, int r_stride, double factor,
                 int steps, double* t, int nt);
 void principal_hz(const double* X, const double* N, i64 n, double* PD1, double* PD2, double* PV1,
                   double* PV2, int nt);
-int intrinsic_smoothing(const double* V, const i64* F, i64 nF, i64 nV, const i64* E, i64 nE, const i64* EF,
-                        const i64* ELI, const double* C0, const double* m, const double* phase,
+int intrinsic_smoothing(const double* V, const i64* F, i64 nF, i64 nV, const i32* E, i64 nE, const i32* EF,
+                        const i8* ELI, const double* C0, const double* m, const double* phase,
                         const double* rough, double radius, double per_radius, double pilot_radius,
                         double pilot_rtol, double gain, double power, double lo, double hi, int steps,
                         const std::vector<double>& binom, double rtol, i64 maxiter, double* X, double* r,
                         int nt, i64* iterations, i64* ngroups);
-int smooth_vertex_tensors(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* ELI, const double* C,
+int smooth_vertex_tensors(i64 nV, const i32* E, i64 nE, const i32* EF, const i8* ELI, const double* C,
                           const double* m, double t, int steps, const std::vector<double>& binom,
                           double rtol, i64 maxiter, double* X, int nt, i64* iterations);
 
@@ -274,8 +279,10 @@ struct LDLFactor {
 // greedily, heaviest first, to the group with less work (nonzeros + 1 per column).
 void ldl_schedule(LDLFactor& f);
 void ldl_solve_block(const LDLFactor& f, int k, const double* r, double* z, double* w, int nt);
-PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const double* Ax,
-                    const i64* Mp, const std::int32_t* Mi, const double* Mx, const double* dinv,
+// I = i64 or i32: the row pointers of A and M (explicitly instantiated in pcg.cpp)
+template <class I>
+PCGResult block_pcg(i64 n, int k, const I* Ap, const std::int32_t* Ai, const double* Ax,
+                    const I* Mp, const std::int32_t* Mi, const double* Mx, const double* dinv,
                     double* R, double* X, double rtol, i64 maxiter,
                     i64 probe_iter, double max_predicted, int nt,
                     const SubdomainSolve* sub = nullptr, bool coupled = false);

@@ -58,7 +58,7 @@ void local_mass(const double* V, const i64* F, i64 nF, double* Aloc, double* sin
 // couplings to the other two edges of the face on side 0 / side 1 (col = e,
 // value 0 when the side is missing).  The same layout serves A and the Schwarz M
 // (cols may be nullptr when the columns are already known).  Columns are int32.
-void assemble_ell(const double* blk, const i64* FE, const i64* EF, const i64* ELI, i64 nE,
+void assemble_ell(const double* blk, const i32* FE, const i32* EF, const i8* ELI, i64 nE,
                   std::int32_t* cols, double* vals, int nt) {
 #ifdef IGL_HHJ_OPENMP
 #pragma omp parallel for schedule(static) num_threads(nt)
@@ -95,7 +95,7 @@ void assemble_ell(const double* blk, const i64* FE, const i64* EF, const i64* EL
 // numerically singular (pivot < 1e-8: near-degenerate triangle) gets the Jacobi
 // block diag(1/blk_ii) instead, so M stays SPD for every accepted mesh.
 // Returns the number of such faces.  inv may alias Aloc (each face reads its block first).
-i64 face_schwarz(const double* Aloc, const double* diag, const i64* FE, const unsigned char* fixed,
+i64 face_schwarz(const double* Aloc, const double* diag, const i32* FE, const unsigned char* fixed,
                  i64 nF, double* inv, int nt) {
     i64 n_jacobi = 0;
 #ifdef IGL_HHJ_OPENMP
@@ -141,7 +141,7 @@ i64 face_schwarz(const double* Aloc, const double* diag, const i64* FE, const un
 
 // jump_apply: out (#E, k) = B W, B[e, v] = sum_{T∋e} l_e n_{e,T}.grad(lambda_v)|_T
 // (b_h(phi_e, lambda_v), eq. 3.8 on flat P1 triangles), W (#V, k).
-void jump_apply(const double* V, const i64* F, i64 nF, const i64* EF, const i64* ELI, i64 nE,
+void jump_apply(const double* V, const i64* F, i64 nF, const i32* EF, const i8* ELI, i64 nE,
                 const double* W, int k, double* out, int nt) {
     std::vector<double> c((size_t)nF * 3 * k);
 #ifdef IGL_HHJ_OPENMP
@@ -176,7 +176,7 @@ void jump_apply(const double* V, const i64* F, i64 nF, const i64* EF, const i64*
 
 // shape_operator_faces: S[f] (3x3) = -sum_k nu_T^k sigma^k|_T (eq. 5.12) with
 // sigma^k|_T = sum_j s[e(f,j), k] phi_j;  s (#E, 3).
-void shape_operator_faces(const double* V, const i64* F, const i64* FE, i64 nF,
+void shape_operator_faces(const double* V, const i64* F, const i32* FE, i64 nF,
                           const double* s, double* S, int nt) {
 #ifdef IGL_HHJ_OPENMP
 #pragma omp parallel for schedule(static) num_threads(nt)
@@ -186,7 +186,7 @@ void shape_operator_faces(const double* V, const i64* F, const i64* FE, i64 nF,
         face_geom(V, F, f, g);
         double out[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
         for (int j = 0; j < 3; ++j) {
-            const double* sj = s + 3 * FE[3 * f + j];
+            const double* sj = s + 3 * (i64)FE[3 * f + j];
             const double c = -(sj[0] * g.nu[0] + sj[1] * g.nu[1] + sj[2] * g.nu[2]);
             double phi[3][3];
             basis_tensor(g, j, phi);
@@ -199,7 +199,7 @@ void shape_operator_faces(const double* V, const i64* F, const i64* FE, i64 nF,
 }
 
 // face_tensors: H[f, kk] (3x3) = sum_j s[e(f,j), kk] phi_j (HHJ function on each face); s (#E, k).
-void face_tensors(const double* V, const i64* F, const i64* FE, i64 nF,
+void face_tensors(const double* V, const i64* F, const i32* FE, i64 nF,
                   const double* s, int k, double* H, int nt) {
 #ifdef IGL_HHJ_OPENMP
 #pragma omp parallel for schedule(static) num_threads(nt)
@@ -213,7 +213,7 @@ void face_tensors(const double* V, const i64* F, const i64* FE, i64 nF,
             double* out = H + ((size_t)f * k + kk) * 9;
             for (int p = 0; p < 9; ++p) out[p] = 0.0;
             for (int j = 0; j < 3; ++j) {
-                const double c = s[FE[3 * f + j] * k + kk];
+                const double c = s[(i64)FE[3 * f + j] * k + kk];
                 for (int p = 0; p < 3; ++p)
                     for (int q = 0; q < 3; ++q) out[3 * p + q] += c * phi[j][p][q];
             }

@@ -212,7 +212,7 @@ int pcg_hz(const HZSystem& S, const std::int32_t* group, i64 ng, const double* b
 // Connected components of the vertex graph (union-find over E), labelled in the order
 // of their smallest vertex; vertices without edges join label 0 (their rows stay 0 in
 // every solve, so they add nothing to any reduction).  Returns the number of labels.
-i64 vertex_groups(i64 nV, const i64* E, i64 nE, std::vector<std::int32_t>& label) {
+i64 vertex_groups(i64 nV, const i32* E, i64 nE, std::vector<std::int32_t>& label) {
     std::vector<i64> parent(nV);
     std::vector<unsigned char> has_edge(nV, 0);
     for (i64 v = 0; v < nV; ++v) parent[v] = v;
@@ -241,15 +241,15 @@ i64 vertex_groups(i64 nV, const i64* E, i64 nE, std::vector<std::int32_t>& label
 // sin of 2 rho, rho the angle in the frame of i of e1_j carried onto the plane of i by
 // the minimal rotation N_j -> N_i (x^2 - y^2, 2xy over x^2 + y^2); 0, 0 where undefined.
 // Frames as tangent_frame, +z for non-finite normals.
-void transport_phases(const double* N, i64 nV, const i64* E, i64 nE, double* phase, int nt) {
+void transport_phases(const double* N, i64 nV, const i32* E, i64 nE, double* phase, int nt) {
     std::vector<double> fr((size_t)nV * 9);
     normal_frames(N, nV, fr.data(), nt);
 #ifdef IGL_HHJ_OPENMP
 #pragma omp parallel for schedule(static) num_threads(nt)
 #endif
     for (i64 e = 0; e < nE; ++e) {
-        const double* fi = &fr[9 * E[2 * e]];
-        const double* fj = &fr[9 * E[2 * e + 1]];
+        const double* fi = &fr[9 * (i64)E[2 * e]];
+        const double* fj = &fr[9 * (i64)E[2 * e + 1]];
         double t[3];
         min_rotation(fj + 3, fj, fi, t);
         const double x = dot3(t, fi + 3), y = dot3(t, fi + 6), n2 = x * x + y * y;
@@ -374,7 +374,8 @@ struct HZProblem {
     std::vector<i64> diag_pos, pos_lo, pos_hi;
     std::vector<std::int32_t> label;
     i64 ngroups = 1;
-    const i64 *E = nullptr, *EF = nullptr, *ELI = nullptr;
+    const i32 *E = nullptr, *EF = nullptr;
+    const i8* ELI = nullptr;
     const double *C0 = nullptr, *m = nullptr;
     i64 nE = 0;
     // E lists i < j in lexicographic order (TriangleMesh.edges): then every row of the
@@ -383,7 +384,7 @@ struct HZProblem {
     bool rows_in_edge_order = true;
     std::vector<double> Y, R, AY, dY, acc, wr, wp, wq;    // work vectors of run()
 
-    HZProblem(i64 nV, const i64* E_, i64 nE_, const i64* EF_, const i64* ELI_, const double* C0_,
+    HZProblem(i64 nV, const i32* E_, i64 nE_, const i32* EF_, const i8* ELI_, const double* C0_,
               const double* m_, const double* phase)
         : E(E_), EF(EF_), ELI(ELI_), C0(C0_), m(m_), nE(nE_) {
         ngroups = vertex_groups(nV, E, nE, label);
@@ -495,8 +496,8 @@ struct HZProblem {
 // pilot_radius, to pilot_rtol), the adaptive per-face radius (adaptive_radius, written
 // to r (#F,)), then the twiced smoothing at it, on one system structure.  Returns the
 // status of the first failed solve (1: pilot, else the final's; X unchanged) or 0.
-int intrinsic_smoothing(const double* V, const i64* F, i64 nF, i64 nV, const i64* E, i64 nE, const i64* EF,
-                        const i64* ELI, const double* C0, const double* m, const double* phase,
+int intrinsic_smoothing(const double* V, const i64* F, i64 nF, i64 nV, const i32* E, i64 nE, const i32* EF,
+                        const i8* ELI, const double* C0, const double* m, const double* phase,
                         const double* rough, double radius, double per_radius, double pilot_radius,
                         double pilot_rtol, double gain, double power, double lo, double hi, int steps,
                         const std::vector<double>& binom, double rtol, i64 maxiter, double* X, double* r,

@@ -12,7 +12,9 @@ namespace hhj {
 // igl.unique_edge_map's uE), face_edges (#F,3) (edge opposite corner i),
 // count (#E,), edge_faces / local_index (#E,2) (column 0: the face whose
 // half-edge runs min->max), sign (#F,3) (+1 where the half-edge x_{i+1}->x_{i+2}
-// runs min->max).  On non-manifold edges (count > 2) the last faces win.
+// runs min->max).  On non-manifold edges (count > 2) the last faces win.  The maps are
+// int32 (indices) and int8 (counts saturated at 127, local indices, signs); at most
+// 2^31 - 1 unique edges (checked here) and vertex indices below 2^31 (the binding).
 void topology(const i64* F, i64 nF, i64 nV, Topology& T) {
     const i64 nH = 3 * nF;
     // half-edge h = 3f + i gets the key (hi << 32) | h, bucketed by its lower vertex: sorting
@@ -50,7 +52,7 @@ void topology(const i64* F, i64 nF, i64 nV, Topology& T) {
         }
     }
     T.face_edges.assign(nH, 0);
-    T.sign.assign(nH, 0.0);
+    T.sign.assign(nH, 0);
     T.edges.clear();
     T.edges.reserve(nH);  // ~ #E * 2 = 2/3 nH * 2
     i64 nE = 0, prev_lo = -1, prev_hi = -1;
@@ -59,14 +61,17 @@ void topology(const i64* F, i64 nF, i64 nV, Topology& T) {
             const i64 h = (i64)(order[p] & 0xffffffffULL);
             const i64 hi = (i64)(order[p] >> 32);
             if (v != prev_lo || hi != prev_hi) {
-                T.edges.push_back(v);
-                T.edges.push_back(hi);
+                if (nE == INT32_MAX)     // the int32 maps hold at most 2^31 - 1 edges
+                    throw std::invalid_argument("topology: the mesh has 2**31 or more unique edges; "
+                                                "igl_hhj's int32 edge maps hold at most 2**31 - 1");
+                T.edges.push_back((i32)v);
+                T.edges.push_back((i32)hi);
                 prev_lo = v; prev_hi = hi;
                 ++nE;
             }
-            T.face_edges[h] = nE - 1;
+            T.face_edges[h] = (i32)(nE - 1);
             const i64 f = h / 3, i = h % 3;
-            T.sign[h] = (F[3 * f + (i + 1) % 3] == v) ? 1.0 : -1.0;
+            T.sign[h] = (F[3 * f + (i + 1) % 3] == v) ? 1 : -1;
         }
     }
     T.n_edges = nE;
@@ -75,10 +80,10 @@ void topology(const i64* F, i64 nF, i64 nV, Topology& T) {
     T.local_index.assign(2 * nE, -1);
     for (i64 h = 0; h < nH; ++h) {  // ascending (f, i): the last write wins, as in numpy
         const i64 e = T.face_edges[h];
-        ++T.count[e];
+        if (T.count[e] < INT8_MAX) ++T.count[e];      // saturates: only 1, 2 and > 2 matter
         const int col = T.sign[h] < 0 ? 1 : 0;
-        T.edge_faces[2 * e + col] = h / 3;
-        T.local_index[2 * e + col] = h % 3;
+        T.edge_faces[2 * e + col] = (i32)(h / 3);
+        T.local_index[2 * e + col] = (i8)(h % 3);
     }
 }
 
@@ -103,7 +108,7 @@ inline std::uint64_t spread3(std::uint64_t x) {  // 21 bits -> every third bit
 // sparse sweeps.  2048 cells per axis are finer than the edges of any mesh that fits in
 // memory along a curve; 33-bit codes sort in three stable 11-bit radix passes whose
 // 2048 buckets stay in cache (16-bit digits over 63-bit codes took 2.5x longer).
-void edge_morton_order(const double* V, i64 nV, const i64* E, i64 nE, i64* perm) {
+void edge_morton_order(const double* V, i64 nV, const i32* E, i64 nE, i64* perm) {
     constexpr int BITS = 11;
     constexpr double CELLS = (double)((1 << BITS) - 1);
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -117,7 +122,7 @@ void edge_morton_order(const double* V, i64 nV, const i64* E, i64 nE, i64* perm)
     for (i64 e = 0; e < nE; ++e) {
         std::uint64_t code = 0;
         for (int a = 0; a < 3; ++a) {
-            const double mid = 0.5 * (V[3 * E[2 * e] + a] + V[3 * E[2 * e + 1] + a]);
+            const double mid = 0.5 * (V[3 * (i64)E[2 * e] + a] + V[3 * (i64)E[2 * e + 1] + a]);
             double q = (mid - lo[a]) * scale;
             q = q >= 0 ? (q > CELLS ? CELLS : q) : 0.0;     // NaN -> 0 (no UB cast)
             code |= spread3((std::uint64_t)q) << a;

@@ -30,8 +30,9 @@ struct Partials {
 
 // y = Op x for CSR (p, i, v) or, without it, y = dinv .* x;  partial sums of d.y per chunk.
 // K = number of columns known at compile time (0: runtime k), local accumulators.
-template <int K>
-void apply_and_dot_k(i64 n, int kr, const i64* p, const std::int32_t* idx, const double* v, const double* dinv,
+// I = the row pointer's type (int32 for the HHJ system's fixed-width rows, else int64).
+template <int K, class I>
+void apply_and_dot_k(i64 n, int kr, const I* p, const std::int32_t* idx, const double* v, const double* dinv,
                      const double* x, double* y, const double* d, Partials& P, int nt) {
     const int k = K ? K : kr;
 #ifdef IGL_HHJ_OPENMP
@@ -63,13 +64,14 @@ void apply_and_dot_k(i64 n, int kr, const i64* p, const std::int32_t* idx, const
     }
 }
 
-void apply_and_dot(i64 n, int k, const i64* p, const std::int32_t* idx, const double* v, const double* dinv,
+template <class I>
+void apply_and_dot(i64 n, int k, const I* p, const std::int32_t* idx, const double* v, const double* dinv,
                    const double* x, double* y, const double* d, Partials& P, int nt) {
     switch (k) {
-        case 1: apply_and_dot_k<1>(n, k, p, idx, v, dinv, x, y, d, P, nt); break;
-        case 3: apply_and_dot_k<3>(n, k, p, idx, v, dinv, x, y, d, P, nt); break;
-        case 6: apply_and_dot_k<6>(n, k, p, idx, v, dinv, x, y, d, P, nt); break;
-        default: apply_and_dot_k<0>(n, k, p, idx, v, dinv, x, y, d, P, nt);
+        case 1: apply_and_dot_k<1, I>(n, k, p, idx, v, dinv, x, y, d, P, nt); break;
+        case 3: apply_and_dot_k<3, I>(n, k, p, idx, v, dinv, x, y, d, P, nt); break;
+        case 6: apply_and_dot_k<6, I>(n, k, p, idx, v, dinv, x, y, d, P, nt); break;
+        default: apply_and_dot_k<0, I>(n, k, p, idx, v, dinv, x, y, d, P, nt);
     }
 }
 
@@ -134,8 +136,9 @@ void update(i64 n, int k, const double* alpha, double* X, double* r, const doubl
 // max_predicted would remain, the solve stops early (status 2) so the caller can switch
 // solvers.
 // Status 3: breakdown (p.Ap <= 0 or the residual grew 1e4-fold: A numerically singular).
-PCGResult block_pcg(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const double* Ax,
-                    const i64* Mp, const std::int32_t* Mi, const double* Mx, const double* dinv,
+template <class I>
+PCGResult block_pcg(i64 n, int k, const I* Ap, const std::int32_t* Ai, const double* Ax,
+                    const I* Mp, const std::int32_t* Mi, const double* Mx, const double* dinv,
                     double* R, double* X, double rtol, i64 maxiter,
                     i64 probe_iter, double max_predicted, int nt, const SubdomainSolve* sub,
                     bool coupled) {
@@ -353,6 +356,14 @@ void ldl_solve_block(const LDLFactor& f, int k, const double* r, double* z, doub
         }
     }
 }
+
+// the two row-pointer types (kernels.block_pcg picks int32 when A's and M's are)
+template PCGResult block_pcg<i64>(i64, int, const i64*, const std::int32_t*, const double*, const i64*,
+                                  const std::int32_t*, const double*, const double*, double*, double*, double,
+                                  i64, i64, double, int, const SubdomainSolve*, bool);
+template PCGResult block_pcg<i32>(i64, int, const i32*, const std::int32_t*, const double*, const i32*,
+                                  const std::int32_t*, const double*, const double*, double*, double*, double,
+                                  i64, i64, double, int, const SubdomainSolve*, bool);
 
 }  // namespace hhj
 

@@ -32,7 +32,7 @@ inline void face_cross(const double* V, const i64* F, i64 f, double c[3]) {
 // recovery_weights: w[f] = |T| min(1, q~_T / floor), q_T = 4 sqrt(3) |T| / (l0^2 + l1^2 + l2^2)
 // (recovery.face_quality, non-finite -> 0), q~_T = min of q over T and its edge
 // neighbours (recovery.recovery_weights).  FE (#F,3), EF (#E,2); w (#F,).
-void recovery_weights(const double* V, const i64* F, i64 nF, const i64* FE, const i64* EF, i64 nE,
+void recovery_weights(const double* V, const i64* F, i64 nF, const i32* FE, const i32* EF, i64 nE,
                       double floor, double* w, int nt) {
     std::vector<double> q(nF), qe(nE);
 #ifdef IGL_HHJ_OPENMP
@@ -277,7 +277,7 @@ void tangent_projection6(double* X, const double* N, const unsigned char* ref, i
 // v, upper neighbours], ascending.  L values: -w_e off the diagonal, sum of the w_e
 // on it, w_e = sum over the edge's faces of C[f, i] (C (#F,3): the face's cotangent
 // stiffness entry of the edge opposite corner i, recovery.smoothing_matrices).
-void vertex_laplacian(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* ELI, const double* C,
+void vertex_laplacian(i64 nV, const i32* E, i64 nE, const i32* EF, const i8* ELI, const double* C,
                       std::vector<i64>& indptr, std::vector<std::int32_t>& indices,
                       std::vector<double>& L, std::vector<i64>& diag_pos,
                       std::vector<i64>* pos_lo_out, std::vector<i64>* pos_hi_out) {
@@ -315,7 +315,7 @@ void vertex_laplacian(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* EL
 // recovery.smooth_vertex_tensors.  m (#V,) the lumped mass (floored), binom the
 // coefficients binom(order, j) (-1)^(j+1), j = 1..order.  Returns 0, or the PCG
 // status of the first solve that did not converge (X is then left unchanged).
-int smooth_vertex_tensors(i64 nV, const i64* E, i64 nE, const i64* EF, const i64* ELI, const double* C,
+int smooth_vertex_tensors(i64 nV, const i32* E, i64 nE, const i32* EF, const i8* ELI, const double* C,
                           const double* m, double t, int steps, const std::vector<double>& binom,
                           double rtol, i64 maxiter, double* X, int nt, i64* iterations) {
     std::vector<i64> indptr, diag_pos;
@@ -348,9 +348,9 @@ int smooth_vertex_tensors(i64 nV, const i64* E, i64 nE, const i64* EF, const i64
                 }
                 for (int c = 0; c < 6; ++c) R[6 * v + c] = m[v] * Y[6 * v + c] - acc[c];
             }
-            PCGResult res = block_pcg(nV, 6, indptr.data(), indices.data(), A.data(), nullptr, nullptr,
-                                      nullptr, dinv.data(), R.data(), dY.data(), rtol, maxiter, 0,
-                                      std::numeric_limits<double>::infinity(), nt);
+            PCGResult res = block_pcg<i64>(nV, 6, indptr.data(), indices.data(), A.data(), nullptr, nullptr,
+                                           nullptr, dinv.data(), R.data(), dY.data(), rtol, maxiter, 0,
+                                           std::numeric_limits<double>::infinity(), nt);
             *iterations += res.iterations;
             if (res.status != 0) return res.status;
             for (size_t q = 0; q < n6; ++q) Y[q] += std::isfinite(dY[q]) ? dY[q] : 0.0;
@@ -504,7 +504,7 @@ bool quadric_fit(const double* X, const double* xv, const i64* nb, i64 cnt, cons
 
 }  // namespace
 
-void boundary_normal_fits(const double* X, i64 nV, const i64* E, i64 nE, const i64* verts, i64 n, int rings,
+void boundary_normal_fits(const double* X, i64 nV, const i32* E, i64 nE, const i64* verts, i64 n, int rings,
                           const double* N0, double* N, int nt) {
     std::vector<i64> ptr(nV + 1, 0), adj(2 * nE);
     for (i64 e = 0; e < nE; ++e) { ++ptr[E[2 * e] + 1]; ++ptr[E[2 * e + 1] + 1]; }

@@ -130,7 +130,7 @@ int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0
             for (int a = 0; a < 3; ++a) fn[3 * q + a] = cross[3 * bface[q] + a] / dbl[bface[q]];
         for (int col = 0; col < 2; ++col)
             for (i64 q = 0; q < nb; ++q)
-                for (int a = 0; a < 3; ++a) full[3 * T.edges[2 * bnd_edges[q] + col] + a] += fn[3 * q + a];
+                for (int a = 0; a < 3; ++a) full[3 * (i64)T.edges[2 * bnd_edges[q] + col] + a] += fn[3 * q + a];
         Nb.assign((size_t)nV * 3, NAN);
         for (i64 q = 0; q < n; ++q)
             for (int a = 0; a < 3; ++a) Nb[3 * bverts[q] + a] = Nfit[3 * q + a];
@@ -179,8 +179,9 @@ int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0
     std::vector<i64> perm(nE), iperm(nE);
     edge_morton_order(V, nV, T.edges.data(), nE, perm.data());
     for (i64 i = 0; i < nE; ++i) iperm[perm[i]] = i;
-    std::vector<i64> FEp((size_t)nF * 3), EFp((size_t)nE * 2), ELIp((size_t)nE * 2);
-    for (i64 q = 0; q < 3 * nF; ++q) FEp[q] = iperm[T.face_edges[q]];
+    std::vector<i32> FEp((size_t)nF * 3), EFp((size_t)nE * 2);
+    std::vector<i8> ELIp((size_t)nE * 2);
+    for (i64 q = 0; q < 3 * nF; ++q) FEp[q] = (i32)iperm[T.face_edges[q]];
     for (i64 i = 0; i < nE; ++i)
         for (int c = 0; c < 2; ++c) {
             EFp[2 * i + c] = T.edge_faces[2 * perm[i] + c];
@@ -195,8 +196,8 @@ int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0
     for (i64 q = 0; q < 3 * nE; ++q) load[q] = -load[q];                                      // -B X
     std::vector<double> len(nE);
     for (i64 e = 0; e < nE; ++e) {
-        const double* a = V + 3 * T.edges[2 * e];
-        const double* b = V + 3 * T.edges[2 * e + 1];
+        const double* a = V + 3 * (i64)T.edges[2 * e];
+        const double* b = V + 3 * (i64)T.edges[2 * e + 1];
         const double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
         len[e] = std::sqrt(dot3(d, d));          // (d0² + d1²) + d2², as mesh.unique_edge_lengths
     }
@@ -220,7 +221,7 @@ int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0
             for (int a = 0; a < 3; ++a) {
                 double pe[2];
                 for (int c = 0; c < 2; ++c) {
-                    const double* nv = &Nb[3 * T.edges[2 * e + c]];
+                    const double* nv = &Nb[3 * (i64)T.edges[2 * e + c]];
                     const double v = (k == a ? 1.0 : 0.0) - nv[k] * nv[a];
                     pe[c] = std::isfinite(v) ? v : 0.0;
                 }

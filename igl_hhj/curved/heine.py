@@ -42,7 +42,7 @@ class LagrangeSpace:
         el[:, :3] = mesh.F
         slots = edge_node_slots(g)
         for j in range(3):                     # 3 local edges, vectorised over faces
-            e = mesh.face_edges[:, j]
+            e = mesh.face_edges[:, j].astype(np.int64)   # int32 map: the node ids in int64
             fw = mesh.edges[e, 0] == mesh.F[:, (j + 1) % 3]
             ids = nV + e[:, None] * (g - 1) + np.arange(g - 1)[None]
             el[:, slots[j]] = np.where(fw[:, None], ids, ids[:, ::-1])

@@ -128,7 +128,7 @@ def mapped_nodes(mesh, order, element_map, interpolant="walker"):
     slots = edge_node_slots(order)
     FE = mesh.face_edges
     for j in range(3):                       # 3 local edges: vectorised over faces
-        e = FE[:, j]
+        e = FE[:, j].astype(np.int64)        # int32 map: the node ids in int64
         fw = E[e, 0] == Ff[:, (j + 1) % 3]   # local edge j runs from corner j+1 to j+2
         ids = nV + e[:, None] * (order - 1) + np.arange(order - 1)[None]
         ids = np.where(fw[:, None], ids, ids[:, ::-1])

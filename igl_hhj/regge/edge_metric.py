@@ -56,7 +56,7 @@ def squared_edge_lengths(V, F):
     uE : (#E, 2) int64, ``igl.unique_edge_map(F)[1]``
     """
     m = as_mesh(V, F)
-    return m.unique_edge_lengths ** 2, m.edges
+    return m.unique_edge_lengths ** 2, m.edges.astype(np.int64)     # a copy: mesh.edges is int32
 
 
 def _topology(F, nV=None):

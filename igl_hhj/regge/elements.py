@@ -209,7 +209,7 @@ class LagrangeSpace:
         cols = [F]
         j = np.arange(ne)
         for i in range(3):
-            e = m.face_edges[:, i]
+            e = m.face_edges[:, i].astype(np.int64)      # int32 map: nV + e ne in int64
             fwd = m.face_edge_sign[:, i] > 0
             jj = np.where(fwd[:, None], j[None, :], ne - 1 - j[None, :])
             cols.append(nV + e[:, None] * ne + jj)
