@@ -829,13 +829,15 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
 
 
 def dropin_on_mesh(mesh, radius, boundary, boundary_normals, boundary_shape_operator, simply_supported,
-                   solver, rtol, groups_of=None, release=False):
+                   solver, rtol, groups_of=None, release=False, by_parts=False):
     """:func:`principal_curvature` on a validated :class:`~igl_hhj.mesh.TriangleMesh` (also
     the cut mesh of :mod:`igl_hhj.features`, with ``groups_of`` the uncut mesh, see
     :func:`_shape_operator`): the boundary treatment, S_h (:func:`_shape_operator`), then
     :func:`dropin_vertex_values`.  ``release``: the mesh's face cross products (24 B/face)
     are dropped from its cache before the solve, the call's memory peak (for a mesh that
-    needs them no more afterwards)."""
+    needs them no more afterwards).  ``by_parts``: the smoothing runs one compiled call per
+    connected component (:func:`igl_hhj.intrinsic.adaptive_smoothing_by_parts`, the sides
+    of the cut)."""
     boundary_normals, treatment = _resolve_boundary(mesh, boundary, boundary_normals,
                                                     boundary_shape_operator)
     rtol = _check_rtol(rtol)
@@ -849,10 +851,10 @@ def dropin_on_mesh(mesh, radius, boundary, boundary_normals, boundary_shape_oper
                         rtol, estimated=treatment == "estimate", groups_of=groups_of)
     holder = [S]     # the only reference: the vertex stage frees S before smoothing
     del S
-    return dropin_vertex_values(mesh, holder, radius, rtol)
+    return dropin_vertex_values(mesh, holder, radius, rtol, by_parts=by_parts)
 
 
-def dropin_vertex_values(mesh, S, radius, rtol=DEFAULT_RTOL):
+def dropin_vertex_values(mesh, S, radius, rtol=DEFAULT_RTOL, by_parts=False):
     """The vertex stage of :func:`principal_curvature` on given face tensors ``S`` (#F, 3, 3).
 
     :func:`igl_hhj.intrinsic.vertex_stage` (intrinsic recovery, adaptive twiced
@@ -866,7 +868,7 @@ def dropin_vertex_values(mesh, S, radius, rtol=DEFAULT_RTOL):
     -------
     PD1, PD2 : (#V, 3), PV1, PV2 : (#V,), bad_vertices : list of int (as :func:`principal_curvature`).
     """
-    X, N = _intrinsic.vertex_stage(mesh, S, radius, rtol=rtol)
+    X, N = _intrinsic.vertex_stage(mesh, S, radius, rtol=rtol, by_parts=by_parts)
     PD1, PD2, PV1, PV2 = kernels.principal_hz(X, N)
     del X
     ref = mesh.referenced_vertices

@@ -427,7 +427,7 @@ def _side_values(V, F, radius, feature_angle, crease_edges, boundary, solver, rt
     mesh, ct, cut, cm = _prepare(V, F, feature_angle, crease_edges, boundary, data)
     return mesh, ct, cut, cm, curvature.dropin_on_mesh(cm, radius, "estimate", None, None, None, solver,
                                                        DEFAULT_RTOL if rtol is None else rtol,
-                                                       groups_of=mesh)
+                                                       groups_of=mesh, by_parts=True)
 
 
 def _feature_dropin(V: Any, F: ArrayLike | None, radius: int, *, feature_angle: float | None,
