@@ -429,3 +429,20 @@ def test_parts_of_the_callers_mesh_stay_independent():
         assert np.abs(x - y).max() <= 1e-12
     S = ft.feature_shape_operator(V2, F2)
     assert np.abs(ft.feature_shape_operator(V, F) - S[:len(F)]).max() <= 1e-12
+
+
+def test_corner_components_are_scipys():
+    """cut_along's union-find (kernels.graph_components) labels the components like
+    scipy.sparse.csgraph.connected_components (in the order of their smallest node), isolated
+    nodes included, so the side numbering of the cut is unchanged; bad indices raise."""
+    from igl_hhj import kernels
+    rng = np.random.default_rng(4)
+    n = 500
+    pairs = rng.integers(0, n, size=(300, 2))
+    label, count = kernels.graph_components(pairs, n)
+    A = sp.coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    ref_count, ref = sp.csgraph.connected_components(A, directed=False)
+    assert count == ref_count and (ref_count > 200)          # many isolated nodes
+    np.testing.assert_array_equal(label, ref)
+    with pytest.raises(ValueError, match="out of range"):
+        kernels.graph_components([[0, n]], n)
