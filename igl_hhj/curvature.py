@@ -836,8 +836,8 @@ def dropin_on_mesh(mesh, radius, boundary, boundary_normals, boundary_shape_oper
     :func:`dropin_vertex_values`.  ``release``: the mesh's face cross products (24 B/face)
     are dropped from its cache before the solve, the call's memory peak (for a mesh that
     needs them no more afterwards).  ``by_parts``: the smoothing runs one compiled call per
-    connected component (:func:`igl_hhj.intrinsic.adaptive_smoothing_by_parts`, the sides
-    of the cut)."""
+    connected component (:func:`igl_hhj.intrinsic.vertex_stage`'s ``by_parts``: the sides
+    of the cut, grouped by the caller's parts)."""
     boundary_normals, treatment = _resolve_boundary(mesh, boundary, boundary_normals,
                                                     boundary_shape_operator)
     rtol = _check_rtol(rtol)

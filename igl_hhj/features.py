@@ -449,9 +449,12 @@ def _side_values(V, F, radius, feature_angle, crease_edges, boundary, solver, rt
     from .solvers import DEFAULT_RTOL
     curvature.check_principal_curvature_args(radius, True)
     mesh, ct, cut, cm = _prepare(V, F, feature_angle, crease_edges, boundary, data)
+    # the smoothing: one call per side, each side's stopping test in the units of the
+    # caller's connected part that it belongs to (intrinsic.adaptive_smoothing_by_parts)
+    parts = kernels.vertex_components(mesh)[0][cut.parent]
     return mesh, ct, cut, cm, curvature.dropin_on_mesh(cm, radius, "estimate", None, None, None, solver,
                                                        DEFAULT_RTOL if rtol is None else rtol,
-                                                       groups_of=mesh, by_parts=True)
+                                                       groups_of=mesh, by_parts=parts)
 
 
 def _feature_dropin(V: Any, F: ArrayLike | None, radius: int, *, feature_angle: float | None,

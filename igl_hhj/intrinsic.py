@@ -362,18 +362,20 @@ def smoothing_rtol(rtol):
 
 
 def adaptive_smoothing(mesh: TriangleMesh, X, C0, mass, phase, rough, radius, rtol,
-                       maxiter=SMOOTHING_MAXITER):
+                       maxiter=SMOOTHING_MAXITER, *, solve_rtol=None):
     """The smoothing of :func:`vertex_stage` with this module's parameters, in place on
     ``X`` (#V, 3): one compiled call (:func:`igl_hhj.kernels.intrinsic_smoothing`: pilot step,
     adaptive per-face radius, twiced smoothing), every solve to :func:`smoothing_rtol` of
     the caller's ``rtol``.  ``C0, mass`` from :func:`igl_hhj.recovery.smoothing_coefficients`,
-    ``phase`` from :func:`igl_hhj.kernels.transport_phases`, ``rough`` from the recovery.
+    ``phase`` from :func:`igl_hhj.kernels.transport_phases`, ``rough`` from the recovery;
+    ``solve_rtol``: the relative residual of every solve instead of :func:`smoothing_rtol`
+    (:func:`adaptive_smoothing_by_parts`).
 
     Returns ``(status, iterations, components, radius (#F,))`` (status 0: every solve converged;
     else X is unchanged)."""
     from . import kernels
     from .recovery import SMOOTHING_PER_RADIUS, _kernel_coefficients
-    srtol = smoothing_rtol(rtol)
+    srtol = smoothing_rtol(rtol) if solve_rtol is None else float(solve_rtol)
     return kernels.intrinsic_smoothing(
         mesh, X, C0, mass, phase, rough, radius, per_radius=SMOOTHING_PER_RADIUS, pilot_radius=PILOT_RADIUS,
         pilot_rtol=srtol, gain=ADAPTIVE_GAIN, power=ADAPTIVE_POWER, bounds=ADAPTIVE_RANGE,
@@ -381,7 +383,7 @@ def adaptive_smoothing(mesh: TriangleMesh, X, C0, mass, phase, rough, radius, rt
 
 
 def adaptive_smoothing_by_parts(mesh: TriangleMesh, X, C0, mass, phase, rough, radius, rtol,
-                                maxiter=SMOOTHING_MAXITER):
+                                maxiter=SMOOTHING_MAXITER, *, scale_groups=None):
     """:func:`adaptive_smoothing` with one compiled call per connected component (those
     with fewer than :data:`SPLIT_MIN_VERTICES` vertices together in one more call), in
     place on ``X`` (#V, 3).
@@ -396,6 +398,20 @@ def adaptive_smoothing_by_parts(mesh: TriangleMesh, X, C0, mass, phase, rough, r
     round-off, and a component's values do not depend on the others at all.  The inputs are
     sliced, not recomputed (:func:`igl_hhj.components.split_parts`).
 
+    Parameters
+    ----------
+    scale_groups : (#V,) int, optional
+        Labels of groups of components (the sides of one connected part of the caller's
+        mesh, for a cut) whose common scale sets the stopping tests: a component c of
+        group g is solved to the relative residual ``min(1, s · max(1, |X|_g / |X|_c))``,
+        ``s`` = :func:`smoothing_rtol`, ``|X|`` the RMS of the components (h, z) over the
+        rows.  The uncut part was one solve with one test ``|r| ≤ s |b|`` over all its
+        rows; cut, each side would be solved to ``s`` of its *own* values, and a flat side
+        (fandisk: values 1e-6 of the part's curvature) would spend 130-230 iterations on
+        digits that are round-off of the part's.  Scaled, every side is solved to the same
+        accuracy in the part's units, and a side with negligible values takes one
+        iteration per solve.  The small components' call keeps ``s``.
+
     Returns ``(status, iterations, components, radius (#F,))`` as :func:`adaptive_smoothing`
     (iterations: the largest of a call's; status: the first failed call's, X then unchanged).
     """
@@ -409,14 +425,32 @@ def adaptive_smoothing_by_parts(mesh: TriangleMesh, X, C0, mass, phase, rough, r
         return adaptive_smoothing(mesh, X, C0, mass, phase, rough, radius, rtol, maxiter)
     call = np.full(n, nbig, dtype=np.int64)           # the small components: one call, the last
     call[big] = np.arange(nbig)
+    srtol = smoothing_rtol(rtol)
+    tol = np.full(nbig + 1, srtol)
+    if scale_groups is not None:
+        g = np.asarray(scale_groups, dtype=np.int64)
+        if g.shape != (mesh.n_vertices,):
+            raise ValueError(f"scale_groups must have shape ({mesh.n_vertices},), got {g.shape}")
+        x2 = (X * X).sum(axis=1)
+        x2 = np.where(np.isfinite(x2), x2, 0.0)
+        cl = call[labels]
+        _, first = np.unique(cl, return_index=True)    # a vertex of each call: its component's
+        #                                                group (the cut refines the caller's parts)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ms_call = np.bincount(cl, x2, nbig + 1)[:nbig] / size[big]
+            ms_group = np.bincount(g, x2) / np.bincount(g)
+            ratio = np.sqrt(ms_group[g[first[:nbig]]] / ms_call)
+        ratio = np.where(np.isfinite(ratio), np.maximum(ratio, 1.0), np.inf)   # 0/0, x/0: no scale
+        tol[:nbig] = np.minimum(1.0, srtol * ratio)
     (vo, fo, eo), parts = split_parts(mesh, call[labels], nbig + int(nbig < n))
     Xp, C0p, php = (np.take(A, o, axis=0) for A, o in ((X, vo), (C0, fo), (phase, eo)))
     mp, rp = np.take(mass, vo), np.take(rough, vo)
     r = np.empty(mesh.n_faces)
     its = 0
-    for sub, v, f, e in parts:
+    for c, (sub, v, f, e) in enumerate(parts):
         x = Xp[v]                                     # a contiguous view: smoothed in place
-        status, k, _, rf = adaptive_smoothing(sub, x, C0p[f], mp[v], php[e], rp[v], radius, rtol, maxiter)
+        status, k, _, rf = adaptive_smoothing(sub, x, C0p[f], mp[v], php[e], rp[v], radius, rtol, maxiter,
+                                              solve_rtol=tol[c])
         if status != 0:
             return status, its, n, r
         r[fo[f]] = rf
@@ -438,10 +472,12 @@ def vertex_stage(mesh: TriangleMesh, S, radius, *, rtol=None, maxiter=SMOOTHING_
     rtol : float, the caller's tolerance (default :data:`igl_hhj.solvers.DEFAULT_RTOL`);
         every smoothing solve runs to the relative residual :func:`smoothing_rtol` of it.
     info : dict, optional; receives ``smoothing_iterations`` and ``components``.
-    by_parts : bool, default False
-        Smooth each connected component in its own compiled call
-        (:func:`adaptive_smoothing_by_parts`; the sides of the cut of
-        :mod:`igl_hhj.features`); the same values to round-off.
+    by_parts : bool or (#V,) int array, default False
+        True: smooth each connected component in its own compiled call
+        (:func:`adaptive_smoothing_by_parts`), the same values to round-off.  An array:
+        the same, each component solved to the tolerance of the scale of its group
+        (``scale_groups`` of :func:`adaptive_smoothing_by_parts`; the sides of the cut of
+        :mod:`igl_hhj.features`, grouped by the caller's connected parts).
 
     Returns
     -------
@@ -464,8 +500,12 @@ def vertex_stage(mesh: TriangleMesh, S, radius, *, rtol=None, maxiter=SMOOTHING_
         return X, N
     C0, m = smoothing_coefficients(mesh, w)
     phase = kernels.transport_phases(mesh, N)
-    smoothing = adaptive_smoothing_by_parts if by_parts else adaptive_smoothing
-    status, its, ncomp, r = smoothing(mesh, X, C0, m, phase, rough, radius, rtol, maxiter)
+    if isinstance(by_parts, bool) and not by_parts:
+        status, its, ncomp, r = adaptive_smoothing(mesh, X, C0, m, phase, rough, radius, rtol, maxiter)
+    else:
+        status, its, ncomp, r = adaptive_smoothing_by_parts(
+            mesh, X, C0, m, phase, rough, radius, rtol, maxiter,
+            scale_groups=None if isinstance(by_parts, bool) else by_parts)
     if info is not None:
         info.update(smoothing_iterations=its, components=ncomp, radius_median=float(np.median(r)))
     if status != 0:          # a solve stalled (the kernel left X unchanged): the direct reference
