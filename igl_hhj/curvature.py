@@ -139,7 +139,17 @@ def _boundary_face_and_conormal(mesh, e):
     return f, mesh.conormals_at(f, i)
 
 
-def _normalised_boundary_normals(mesh, boundary_normals, clamped):
+def _normalised_boundary_normals(mesh, boundary_normals, clamped, estimated=False):
+    """The boundary normals on the clamped edges' vertices scaled to unit length, after the
+    checks of the caller's data (finite, bounded, non-zero, on the side of F's normals).
+    ``estimated``: the normals of :func:`estimate_boundary_normals`, which pass every
+    check by construction (unit, NaN rows dropped by :func:`_boundary_partition`, at
+    least ``SIDE_DOT_MIN`` with every boundary face): only scaled."""
+    if estimated:
+        verts = np.unique(mesh.edges[clamped].ravel())
+        N = np.array(boundary_normals, dtype=np.float64)
+        N[verts] /= np.linalg.norm(N[verts], axis=1)[:, None]
+        return N
     N = per_vertex_array(mesh, boundary_normals, "boundary_normals", (3,))
     verts = _data_rows(mesh, N, clamped, "boundary_normals")
     norm = np.linalg.norm(N[verts], axis=1)
@@ -233,7 +243,7 @@ def _shape_operator_one(mesh, boundary_normals, boundary_shape_operator, simply_
     """:func:`_shape_operator` on one solve group (the whole mesh, or a group of components)."""
     clamped, ss_edges = _boundary_partition(mesh, boundary_normals, boundary_shape_operator,
                                             simply_supported, estimated)
-    N = _normalised_boundary_normals(mesh, boundary_normals, clamped) if clamped.any() else None
+    N = _normalised_boundary_normals(mesh, boundary_normals, clamped, estimated) if clamped.any() else None
     fixed = ss_edges if ss_edges.any() else None
     if fixed is not None:
         rho = _simply_supported_values(mesh, boundary_shape_operator, ss_edges)
