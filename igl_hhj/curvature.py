@@ -145,9 +145,9 @@ def _normalised_boundary_normals(mesh, boundary_normals, clamped, estimated=Fals
     ``estimated``: the normals of :func:`estimate_boundary_normals`, which pass every
     check by construction (unit, NaN rows dropped by :func:`_boundary_partition`, at
     least ``SIDE_DOT_MIN`` with every boundary face): only scaled."""
-    if estimated:
-        verts = np.unique(mesh.edges[clamped].ravel())
+    if estimated:            # every finite row (a superset of the clamped edges' vertices)
         N = np.array(boundary_normals, dtype=np.float64)
+        verts = np.flatnonzero(np.isfinite(N).all(axis=1))
         N[verts] /= np.linalg.norm(N[verts], axis=1)[:, None]
         return N
     N = per_vertex_array(mesh, boundary_normals, "boundary_normals", (3,))
@@ -197,13 +197,11 @@ def _boundary_rhs(mesh, rhs, clamped, N):
         return rhs
     rhs[bnd & ~clamped] = 0.0
     if clamped.any():
-        # ξ^k = ∇_Γ id^k = P e_k, P = I - ν~ ⊗ ν~: gradients of the 3 coordinates.
-        # only the clamped edges' vertices are read: P there, zero elsewhere
-        v = np.unique(mesh.edges[clamped].ravel())
-        P = np.zeros((mesh.n_vertices, 3, 3))                  # (#V, 3, 3): row k = ξ^k
-        Pv = np.eye(3)[None] - N[v, :, None] * N[v, None, :]
-        Pv[~np.isfinite(Pv)] = 0.0
-        P[v] = Pv
+        # ξ^k = ∇_Γ id^k = P e_k, P = I - ν~ ⊗ ν~: gradients of the 3 coordinates; only the
+        # clamped edges' vertices are read (N is finite there), rows without N are zero
+        with np.errstate(over="ignore", invalid="ignore"):    # unread rows may be anything
+            P = np.eye(3)[None] - N[:, :, None] * N[:, None, :]  # (#V, 3, 3): row k = ξ^k
+        P[~np.isfinite(P)] = 0.0
         rhs[clamped] += clamped_load(mesh, clamped, P)[clamped]
     return rhs
 

@@ -385,8 +385,8 @@ def adaptive_smoothing(mesh: TriangleMesh, X, C0, mass, phase, rough, radius, rt
 def adaptive_smoothing_by_parts(mesh: TriangleMesh, X, C0, mass, phase, rough, radius, rtol,
                                 maxiter=SMOOTHING_MAXITER, *, scale_groups=None):
     """:func:`adaptive_smoothing` with one compiled call per connected component (those
-    with fewer than :data:`SPLIT_MIN_VERTICES` vertices together in one more call), in
-    place on ``X`` (#V, 3).
+    with fewer than :data:`SPLIT_MIN_VERTICES` vertices together in one more call; one call
+    of the whole mesh where at most one component has that many), in place on ``X`` (#V, 3).
 
     One call on the whole mesh keeps separate CG scalars and stopping tests per
     component, but every iteration sweeps all rows until the slowest component has
@@ -421,7 +421,7 @@ def adaptive_smoothing_by_parts(mesh: TriangleMesh, X, C0, mass, phase, rough, r
     size = np.bincount(labels, minlength=n)
     big = size >= SPLIT_MIN_VERTICES
     nbig = int(big.sum())
-    if n <= 1 or nbig == 0:
+    if nbig <= 1:        # one component worth a call of its own: the others cost it nothing
         return adaptive_smoothing(mesh, X, C0, mass, phase, rough, radius, rtol, maxiter)
     call = np.full(n, nbig, dtype=np.int64)           # the small components: one call, the last
     call[big] = np.arange(nbig)
