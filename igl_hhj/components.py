@@ -98,15 +98,19 @@ def split_parts(mesh: TriangleMesh, labels, n):
     for lab in (labels, take(labels, mesh.F[:, 0]), take(labels, mesh.edges[:, 0])):
         order = np.argsort(lab, kind="stable")
         starts = np.searchsorted(take(lab, order), np.arange(n + 1))
-        local = np.empty(len(lab), dtype=np.int64)
-        local[order] = np.arange(len(lab)) - np.repeat(starts[:-1], np.diff(starts))
-        perms.append((order, starts, local))
-    (vo, vs, vloc), (fo, fs, floc), (eo, es, _) = perms
+        perms.append((order, starts))
+    (vo, vs), (fo, fs), (eo, es) = perms
+    # local index of every vertex and face in its part; the faces' with a last entry -1
+    # for the edges' missing faces (edge_faces -1)
+    vloc = np.empty(len(vo), dtype=np.int64)
+    vloc[vo] = np.arange(len(vo)) - np.repeat(vs[:-1], np.diff(vs))
+    floc = np.empty(len(fo) + 1, dtype=np.int64)
+    floc[fo] = np.arange(len(fo)) - np.repeat(fs[:-1], np.diff(fs))
+    floc[-1] = -1
     V = take(mesh.V, vo, axis=0)
     F = take(vloc, take(mesh.F, fo, axis=0))
     E = take(vloc, take(mesh.edges, eo, axis=0))
-    ef = take(mesh.edge_faces, eo, axis=0)
-    EF = np.where(ef >= 0, take(floc, np.maximum(ef, 0)), -1)
+    EF = take(floc, take(mesh.edge_faces, eo, axis=0))
     ELI = take(mesh.edge_local_index, eo, axis=0)
     parts = []
     for c in range(n):

@@ -425,24 +425,22 @@ def adaptive_smoothing_by_parts(mesh: TriangleMesh, X, C0, mass, phase, rough, r
         return adaptive_smoothing(mesh, X, C0, mass, phase, rough, radius, rtol, maxiter)
     call = np.full(n, nbig, dtype=np.int64)           # the small components: one call, the last
     call[big] = np.arange(nbig)
+    (vo, fo, eo), parts = split_parts(mesh, call[labels], nbig + int(nbig < n))
     srtol = smoothing_rtol(rtol)
-    tol = np.full(nbig + 1, srtol)
+    tol = np.full(len(parts), srtol)
     if scale_groups is not None:
         g = np.asarray(scale_groups, dtype=np.int64)
         if g.shape != (mesh.n_vertices,):
             raise ValueError(f"scale_groups must have shape ({mesh.n_vertices},), got {g.shape}")
         x2 = (X * X).sum(axis=1)
         x2 = np.where(np.isfinite(x2), x2, 0.0)
-        cl = call[labels]
-        _, first = np.unique(cl, return_index=True)    # a vertex of each call: its component's
-        #                                                group (the cut refines the caller's parts)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            ms_call = np.bincount(cl, x2, nbig + 1)[:nbig] / size[big]
+        first = vo[[v.start for _, v, _, _ in parts[:nbig]]]    # a vertex of each big component:
+        with np.errstate(invalid="ignore", divide="ignore"):   # its group (the cut refines the parts)
+            ms_call = np.bincount(call[labels], x2, nbig + 1)[:nbig] / size[big]
             ms_group = np.bincount(g, x2) / np.bincount(g)
-            ratio = np.sqrt(ms_group[g[first[:nbig]]] / ms_call)
+            ratio = np.sqrt(ms_group[g[first]] / ms_call)
         ratio = np.where(np.isfinite(ratio), np.maximum(ratio, 1.0), np.inf)   # 0/0, x/0: no scale
         tol[:nbig] = np.minimum(1.0, srtol * ratio)
-    (vo, fo, eo), parts = split_parts(mesh, call[labels], nbig + int(nbig < n))
     Xp, C0p, php = (np.take(A, o, axis=0) for A, o in ((X, vo), (C0, fo), (phase, eo)))
     mp, rp = np.take(mass, vo), np.take(rough, vo)
     r = np.empty(mesh.n_faces)
