@@ -177,10 +177,12 @@ def estimate_boundary_normals(mesh: TriangleMesh, rings=FIT_RINGS, *, reference=
     f = mesh.edge_faces[be, 0]
     f = np.where(f >= 0, f, mesh.edge_faces[be, 1])
     fn = mesh.face_normals[f]
-    full = np.zeros((nV, 3))
-    for col_ in (0, 1):
-        np.add.at(full, e[be, col_], fn)
-    Nf = full[verts]
+    # Σ of the faces' normals per vertex, summed in the order of np.add.at over column 0
+    # then column 1 of the edges (one bincount per coordinate: the same sums, faster)
+    idx = np.concatenate([e[be, 0], e[be, 1]])
+    Nf = np.empty((len(verts), 3))
+    for k in range(3):
+        Nf[:, k] = np.bincount(idx, np.concatenate([fn[:, k], fn[:, k]]), nV)[verts]
     with np.errstate(invalid="ignore", divide="ignore"):   # cancelling normals: NaN, unusable
         Nf /= np.linalg.norm(Nf, axis=1, keepdims=True)
     out[verts] = N

@@ -139,7 +139,17 @@ def _boundary_face_and_conormal(mesh, e):
     return f, mesh.conormals_at(f, i)
 
 
-def _normalised_boundary_normals(mesh, boundary_normals, clamped):
+def _normalised_boundary_normals(mesh, boundary_normals, clamped, estimated=False):
+    """The boundary normals on the clamped edges' vertices scaled to unit length, after the
+    checks of the caller's data (finite, bounded, non-zero, on the side of F's normals).
+    ``estimated``: the normals of :func:`estimate_boundary_normals`, which pass every
+    check by construction (unit, NaN rows dropped by :func:`_boundary_partition`, at
+    least ``SIDE_DOT_MIN`` with every boundary face): only scaled."""
+    if estimated:            # every finite row (a superset of the clamped edges' vertices)
+        N = np.array(boundary_normals, dtype=np.float64)
+        verts = np.flatnonzero(np.isfinite(N).all(axis=1))
+        N[verts] /= np.linalg.norm(N[verts], axis=1)[:, None]
+        return N
     N = per_vertex_array(mesh, boundary_normals, "boundary_normals", (3,))
     verts = _data_rows(mesh, N, clamped, "boundary_normals")
     norm = np.linalg.norm(N[verts], axis=1)
@@ -187,13 +197,11 @@ def _boundary_rhs(mesh, rhs, clamped, N):
         return rhs
     rhs[bnd & ~clamped] = 0.0
     if clamped.any():
-        # ξ^k = ∇_Γ id^k = P e_k, P = I - ν~ ⊗ ν~: gradients of the 3 coordinates.
-        # only the clamped edges' vertices are read: P there, zero elsewhere
-        v = np.unique(mesh.edges[clamped].ravel())
-        P = np.zeros((mesh.n_vertices, 3, 3))                  # (#V, 3, 3): row k = ξ^k
-        Pv = np.eye(3)[None] - N[v, :, None] * N[v, None, :]
-        Pv[~np.isfinite(Pv)] = 0.0
-        P[v] = Pv
+        # ξ^k = ∇_Γ id^k = P e_k, P = I - ν~ ⊗ ν~: gradients of the 3 coordinates; only the
+        # clamped edges' vertices are read (N is finite there), rows without N are zero
+        with np.errstate(over="ignore", invalid="ignore"):    # unread rows may be anything
+            P = np.eye(3)[None] - N[:, :, None] * N[:, None, :]  # (#V, 3, 3): row k = ξ^k
+        P[~np.isfinite(P)] = 0.0
         rhs[clamped] += clamped_load(mesh, clamped, P)[clamped]
     return rhs
 
@@ -233,7 +241,7 @@ def _shape_operator_one(mesh, boundary_normals, boundary_shape_operator, simply_
     """:func:`_shape_operator` on one solve group (the whole mesh, or a group of components)."""
     clamped, ss_edges = _boundary_partition(mesh, boundary_normals, boundary_shape_operator,
                                             simply_supported, estimated)
-    N = _normalised_boundary_normals(mesh, boundary_normals, clamped) if clamped.any() else None
+    N = _normalised_boundary_normals(mesh, boundary_normals, clamped, estimated) if clamped.any() else None
     fixed = ss_edges if ss_edges.any() else None
     if fixed is not None:
         rho = _simply_supported_values(mesh, boundary_shape_operator, ss_edges)
@@ -829,13 +837,15 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
 
 
 def dropin_on_mesh(mesh, radius, boundary, boundary_normals, boundary_shape_operator, simply_supported,
-                   solver, rtol, groups_of=None, release=False):
+                   solver, rtol, groups_of=None, release=False, by_parts=False):
     """:func:`principal_curvature` on a validated :class:`~igl_hhj.mesh.TriangleMesh` (also
     the cut mesh of :mod:`igl_hhj.features`, with ``groups_of`` the uncut mesh, see
     :func:`_shape_operator`): the boundary treatment, S_h (:func:`_shape_operator`), then
     :func:`dropin_vertex_values`.  ``release``: the mesh's face cross products (24 B/face)
     are dropped from its cache before the solve, the call's memory peak (for a mesh that
-    needs them no more afterwards)."""
+    needs them no more afterwards).  ``by_parts``: the smoothing runs one compiled call per
+    connected component (:func:`igl_hhj.intrinsic.vertex_stage`'s ``by_parts``: the sides
+    of the cut, grouped by the caller's parts)."""
     boundary_normals, treatment = _resolve_boundary(mesh, boundary, boundary_normals,
                                                     boundary_shape_operator)
     rtol = _check_rtol(rtol)
@@ -849,10 +859,10 @@ def dropin_on_mesh(mesh, radius, boundary, boundary_normals, boundary_shape_oper
                         rtol, estimated=treatment == "estimate", groups_of=groups_of)
     holder = [S]     # the only reference: the vertex stage frees S before smoothing
     del S
-    return dropin_vertex_values(mesh, holder, radius, rtol)
+    return dropin_vertex_values(mesh, holder, radius, rtol, by_parts=by_parts)
 
 
-def dropin_vertex_values(mesh, S, radius, rtol=DEFAULT_RTOL):
+def dropin_vertex_values(mesh, S, radius, rtol=DEFAULT_RTOL, by_parts=False):
     """The vertex stage of :func:`principal_curvature` on given face tensors ``S`` (#F, 3, 3).
 
     :func:`igl_hhj.intrinsic.vertex_stage` (intrinsic recovery, adaptive twiced
@@ -866,7 +876,7 @@ def dropin_vertex_values(mesh, S, radius, rtol=DEFAULT_RTOL):
     -------
     PD1, PD2 : (#V, 3), PV1, PV2 : (#V,), bad_vertices : list of int (as :func:`principal_curvature`).
     """
-    X, N = _intrinsic.vertex_stage(mesh, S, radius, rtol=rtol)
+    X, N = _intrinsic.vertex_stage(mesh, S, radius, rtol=rtol, by_parts=by_parts)
     PD1, PD2, PV1, PV2 = kernels.principal_hz(X, N)
     del X
     ref = mesh.referenced_vertices

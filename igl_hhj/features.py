@@ -44,6 +44,7 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
+from . import kernels
 from .mesh import TriangleMesh, _as_array, as_mesh
 
 __all__ = [
@@ -81,15 +82,33 @@ def dihedral_angles(mesh: TriangleMesh) -> NDArray[np.float64]:
     -------
     theta : (#E,) float64, in mesh.edges order; 0 on boundary edges.
     """
+    theta, (inner, f1, n0) = _dihedral_magnitudes(mesh)
+    take = np.take
+    far = take(mesh.V, mesh.F[f1, take(mesh.edge_local_index[:, 1], inner)], axis=0)  # corner opposite e in face 1
+    side = np.einsum("ma,ma->m", n0, far - take(mesh.V, take(mesh.edges[:, 0], inner), axis=0))
+    theta[inner] = np.where(side > 0, -theta[inner], theta[inner])
+    return theta
+
+
+def _dihedral_magnitudes(mesh):
+    """``|θ_e|`` of :func:`dihedral_angles` (#E,) (all the crease test needs), and the inner
+    edges, the faces on their side 1 and the normals of side 0 (for the sign)."""
     theta = np.zeros(mesh.n_edges)
     inner = np.flatnonzero(mesh.edge_face_count == 2)
-    f0, f1 = mesh.edge_faces[inner, 0], mesh.edge_faces[inner, 1]
-    n0, n1 = mesh.face_normals[f0], mesh.face_normals[f1]
-    ang = np.arctan2(np.linalg.norm(np.cross(n0, n1), axis=1), np.einsum("ma,ma->m", n0, n1))
-    far = mesh.V[mesh.F[f1, mesh.edge_local_index[inner, 1]]]          # corner opposite e in face 1
-    side = np.einsum("ma,ma->m", n0, far - mesh.V[mesh.edges[inner, 0]])
-    theta[inner] = np.where(side > 0, -ang, ang)
-    return theta
+    take = np.take                   # rows by np.take: several times faster than fancy indexing
+    ef = take(mesh.edge_faces, inner, axis=0)
+    f1 = ef[:, 1]
+    n0, n1 = take(mesh.face_normals, ef[:, 0], axis=0), take(mesh.face_normals, f1, axis=0)
+    # |ν_0 × ν_1| and ν_0 · ν_1 by components, in the order of np.cross, np.linalg.norm and einsum
+    a0, a1, a2, b0, b1, b2 = n0[:, 0], n0[:, 1], n0[:, 2], n1[:, 0], n1[:, 1], n1[:, 2]
+    c = a1 * b2 - a2 * b1
+    s = c * c
+    c = a2 * b0 - a0 * b2
+    s += c * c
+    c = a0 * b1 - a1 * b0
+    s += c * c
+    theta[inner] = np.arctan2(np.sqrt(s), np.einsum("ma,ma->m", n0, n1))
+    return theta, (inner, f1, n0)
 
 
 def _edge_index(mesh, pairs, name):
@@ -127,7 +146,7 @@ def crease_edges(mesh: TriangleMesh, feature_angle: float | None = DEFAULT_FEATU
     edges : (k, 2) array_like of int, optional
         Crease edges named by their vertex pairs (either order), added to the detected
         ones.  Boundary edges are refused (they are already boundary).
-    theta : (#E,) float64, optional, :func:`dihedral_angles` if already computed.
+    theta : (#E,) float64, optional, :func:`dihedral_angles` (or their magnitudes) if already computed.
 
     Returns
     -------
@@ -243,9 +262,9 @@ def cut_along(mesh: TriangleMesh, crease: NDArray[np.bool_]) -> CutMesh:
 
     The sides of a vertex are the connected components of its corners, two corners
     (of the faces on either side of an edge through the vertex) being connected when
-    the edge is not a crease; a connected-components pass over all 3#F corners
-    (scipy.sparse.csgraph) finds them at once.  A vertex on no crease (or at the end
-    of one) keeps one side and its index.
+    the edge is not a crease; one connected-components pass over all 3#F corners
+    (:func:`igl_hhj.kernels.graph_components`, union-find) finds them at once.  A vertex
+    on no crease (or at the end of one) keeps one side and its index.
 
     ``igl.cut_mesh`` was not used: on a cube cut along its 12 edges it returns 28
     vertices instead of 24 (it cuts to disk topology).
@@ -253,31 +272,37 @@ def cut_along(mesh: TriangleMesh, crease: NDArray[np.bool_]) -> CutMesh:
     F = mesh.F
     nF, nV = mesh.n_faces, mesh.n_vertices
     keep = np.flatnonzero((mesh.edge_face_count == 2) & ~crease)
+    take = np.take
     # int64 (the maps are int32 / int8): 3 f + i would overflow int32 above 715M faces
-    f0, f1 = mesh.edge_faces[keep, 0].astype(np.int64), mesh.edge_faces[keep, 1].astype(np.int64)
-    i0, i1 = mesh.edge_local_index[keep, 0].astype(np.int64), mesh.edge_local_index[keep, 1].astype(np.int64)
+    ef = take(mesh.edge_faces, keep, axis=0).astype(np.int64)
+    li = take(mesh.edge_local_index, keep, axis=0).astype(np.int64)
+    f0, f1, i0, i1 = ef[:, 0], ef[:, 1], li[:, 0], li[:, 1]
     # in f0 the edge runs x_{i0+1} → x_{i0+2}, in f1 the other way: corner i0+1 of f0 is
     # corner i1+2 of f1 (same vertex) and i0+2 of f0 is i1+1 of f1
-    a = np.concatenate([3 * f0 + (i0 + 1) % 3, 3 * f0 + (i0 + 2) % 3])
-    b = np.concatenate([3 * f1 + (i1 + 2) % 3, 3 * f1 + (i1 + 1) % 3])
-    n = 3 * nF
-    A = sp.coo_matrix((np.ones(len(a)), (a, b)), shape=(n, n))
-    ncomp, label = sp.csgraph.connected_components(A, directed=False)
-    corner_vertex = F.ravel()
+    nxt, prv = np.array([1, 2, 0]), np.array([2, 0, 1])
+    pairs = np.empty((2 * len(keep), 2), dtype=np.int64)
+    pairs[:len(keep), 0] = 3 * f0 + take(nxt, i0)
+    pairs[len(keep):, 0] = 3 * f0 + take(prv, i0)
+    pairs[:len(keep), 1] = 3 * f1 + take(prv, i1)
+    pairs[len(keep):, 1] = 3 * f1 + take(nxt, i1)
+    # the components of the corner graph, labelled in the order of their smallest corner
+    # (union-find; the labels of scipy.sparse.csgraph.connected_components)
+    label, ncomp = kernels.graph_components(pairs, 3 * nF)
     parent = np.zeros(ncomp, dtype=np.int64)
-    parent[label] = corner_vertex
+    parent[label] = F.ravel()
+    # primary side of a vertex with several: largest incident area, ties to the lowest
+    # label; its extra sides are numbered from #V on in the order (vertex, -area, label)
+    multi = np.flatnonzero(np.bincount(parent, minlength=nV)[parent] > 1)
     area = np.bincount(label, weights=np.repeat(mesh.face_areas, 3), minlength=ncomp)
-    # primary side: largest incident area, ties to the lowest label
-    order = np.lexsort((np.arange(ncomp), -area, parent))
-    first = np.ones(ncomp, dtype=bool)
+    order = multi[np.lexsort((multi, -area[multi], parent[multi]))]
+    first = np.ones(len(order), dtype=bool)
     first[1:] = parent[order][1:] != parent[order][:-1]
-    new_index = np.empty(ncomp, dtype=np.int64)
-    new_index[order[first]] = parent[order[first]]
+    new_index = parent.copy()
     extra = order[~first]
     new_index[extra] = nV + np.arange(len(extra))
-    Fc = new_index[label].reshape(nF, 3)
+    Fc = take(new_index, label).reshape(nF, 3)
     par = np.concatenate([np.arange(nV), parent[extra]])
-    Vc = mesh.V[par]
+    Vc = take(mesh.V, par, axis=0)
     return CutMesh(V=Vc, F=Fc, parent=par)
 
 
@@ -300,10 +325,10 @@ def _prepare(V, F, feature_angle, crease_edges_, boundary, data):
     if boundary != "estimate":
         raise ValueError(f"feature_angle / crease_edges need boundary='estimate' (each side of a crease "
                          f"is clamped with its estimated normals), got boundary={boundary!r}")
-    theta = dihedral_angles(mesh)
-    crease = crease_edges(mesh, feature_angle, edges=crease_edges_, theta=theta)
+    # the crease test needs |θ_e| only; the signs are for the crease network (crease_network)
+    crease = crease_edges(mesh, feature_angle, edges=crease_edges_, theta=_dihedral_magnitudes(mesh)[0])
     cut, cm = _cut_mesh(mesh, crease)
-    return mesh, (crease, theta), cut, cm
+    return mesh, (crease, None), cut, cm
 
 
 def feature_shape_operator(V: Any, F: ArrayLike | None = None, *,
@@ -427,9 +452,12 @@ def _side_values(V, F, radius, feature_angle, crease_edges, boundary, solver, rt
     from .solvers import DEFAULT_RTOL
     curvature.check_principal_curvature_args(radius, True)
     mesh, ct, cut, cm = _prepare(V, F, feature_angle, crease_edges, boundary, data)
+    # the smoothing: one call per side, each side's stopping test in the units of the
+    # caller's connected part that it belongs to (intrinsic.adaptive_smoothing_by_parts)
+    parts = kernels.vertex_components(mesh)[0][cut.parent]
     return mesh, ct, cut, cm, curvature.dropin_on_mesh(cm, radius, "estimate", None, None, None, solver,
                                                        DEFAULT_RTOL if rtol is None else rtol,
-                                                       groups_of=mesh)
+                                                       groups_of=mesh, by_parts=parts)
 
 
 def _feature_dropin(V: Any, F: ArrayLike | None, radius: int, *, feature_angle: float | None,

@@ -529,6 +529,24 @@ def vertex_components(mesh):
     return _core.vertex_components(_i32(mesh.edges), int(mesh.n_vertices))
 
 
+def graph_components(pairs, n):
+    """Connected components of the graph on ``n`` nodes with the edges ``pairs`` (k, 2):
+    ``(labels (n,) int32, count)``, labelled in the order of their smallest node (the
+    labels of ``scipy.sparse.csgraph.connected_components``), every node its own
+    component unless an edge joins it (one union-find pass, as :func:`vertex_components`)."""
+    pairs = _i64(pairs)
+    if pairs.ndim != 2 or pairs.shape[1] != 2:
+        raise ValueError("graph_components: pairs must be (k, 2)")
+    if pairs.size and (pairs.min() < 0 or pairs.max() >= n):
+        raise ValueError(f"graph_components: node index out of range 0..{n - 1}")
+    alone = np.ones(n, dtype=bool)                     # nodes of no edge: a loop each, so that
+    alone[pairs.ravel()] = False                       # each is its own component
+    loops = np.flatnonzero(alone)
+    if n >= 2**31:
+        raise ValueError("graph_components: at most 2**31 - 1 nodes")
+    return _core.vertex_components(_i32(np.concatenate([pairs, np.stack([loops, loops], axis=1)])), int(n))
+
+
 def transport_phases(mesh, N):
     """(#E, 2) cos and sin of the spin-2 transport of each edge; reference
     :func:`igl_hhj.intrinsic.transport_phase_components`."""

@@ -278,6 +278,24 @@ class TriangleMesh:
                 self.__dict__[key] = mesh.__dict__[key]
         return self
 
+    @classmethod
+    def _with_topology(cls, V, F, edges, edge_faces, edge_local_index):
+        """A mesh ``(V, F)`` with its unique edges and edge-face maps given, built without
+        the checks (internal: :func:`igl_hhj.components.split_parts` slices them from a
+        validated mesh; the arrays must be what :attr:`edges`, :attr:`edge_faces` and
+        :attr:`edge_local_index` would compute)."""
+        self = cls.__new__(cls)
+        self.V = np.ascontiguousarray(V, dtype=np.float64)
+        self.F = np.ascontiguousarray(F, dtype=np.int64)
+        for name, a, dtype in (("edges", edges, np.int32), ("edge_faces", edge_faces, np.int32),
+                               ("edge_local_index", edge_local_index, np.int8)):
+            a = np.ascontiguousarray(a, dtype=dtype)      # the dtypes of the topology maps
+            a.setflags(write=False)
+            self.__dict__[name] = a
+        self.V.setflags(write=False)
+        self.F.setflags(write=False)
+        return self
+
     # ------------------------------------------------------------------ sizes
     @property
     def n_vertices(self):

@@ -289,11 +289,11 @@ def boundary_band(mesh: TriangleMesh, rings=BOUNDARY_BAND_RINGS):
     b = mesh.boundary_vertices.copy()
     if not b.any():
         return b
-    E = mesh.edges
+    E0, E1 = mesh.edges[:, 0], mesh.edges[:, 1]
     for _ in range(rings):
-        grow = b[E]                       # (#E, 2): which endpoints are in the band
-        b[E[grow[:, 1], 0]] = True
-        b[E[grow[:, 0], 1]] = True
+        g0, g1 = np.take(b, E0), np.take(b, E1)        # which endpoints are in the band
+        b[E0[g1]] = True
+        b[E1[g0]] = True
     return b
 
 
@@ -313,7 +313,8 @@ def smoothing_coefficients(mesh: TriangleMesh, weights=None):
         fac = np.where(mesh.face_areas > 0, w / mesh.face_areas, 0.0)
     stiff = fac
     if mesh.has_boundary:       # longer smoothing length ℓ near the boundary: t ∝ ℓ²
-        near = boundary_band(mesh)[F].any(axis=1)
+        band = boundary_band(mesh)
+        near = np.take(band, F[:, 0]) | np.take(band, F[:, 1]) | np.take(band, F[:, 2])
         stiff = fac * np.where(near, BOUNDARY_LENGTH_FACTOR ** 2, 1.0)
     C = np.asarray(igl.cotmatrix_entries(mesh.V, F), dtype=np.float64) * stiff[:, None]
     C = np.where(np.isfinite(C), C, 0.0)

@@ -429,3 +429,63 @@ def test_parts_of_the_callers_mesh_stay_independent():
         assert np.abs(x - y).max() <= 1e-12
     S = ft.feature_shape_operator(V2, F2)
     assert np.abs(ft.feature_shape_operator(V, F) - S[:len(F)]).max() <= 1e-12
+
+
+def test_corner_components_are_scipys():
+    """cut_along's union-find (kernels.graph_components) labels the components like
+    scipy.sparse.csgraph.connected_components (in the order of their smallest node), isolated
+    nodes included, so the side numbering of the cut is unchanged; bad indices raise."""
+    from igl_hhj import kernels
+    rng = np.random.default_rng(4)
+    n = 500
+    pairs = rng.integers(0, n, size=(300, 2))
+    label, count = kernels.graph_components(pairs, n)
+    A = sp.coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    ref_count, ref = sp.csgraph.connected_components(A, directed=False)
+    assert count == ref_count and (ref_count > 200)          # many isolated nodes
+    np.testing.assert_array_equal(label, ref)
+    with pytest.raises(ValueError, match="out of range"):
+        kernels.graph_components([[0, n]], n)
+
+
+def test_side_tolerance_in_the_units_of_the_part(monkeypatch):
+    """The cut's smoothing solves each side to the part's scale (intrinsic.adaptive_smoothing_by_parts
+    with scale_groups): the flat caps of the capped cylinder (values ~1e-14 of the side's
+    curvature) take one CG iteration per solve instead of converging relative to their own
+    round-off, the curved side's solves are unchanged, and every value stays within the
+    smoothing tolerance (1e-3) of the part's RMS of the unscaled solves."""
+    from igl_hhj import kernels
+    from igl_hhj.recovery import QUALITY_FLOOR, smoothing_coefficients
+    V, F, _ = capped_cylinder(3)
+    mesh = as_mesh(V, F)
+    cut, cm = ft._cut_mesh(mesh, ft.crease_edges(mesh))
+    labels, n = kernels.vertex_components(cm)
+    assert n == 3 and (np.bincount(labels) >= intrinsic.SPLIT_MIN_VERTICES).all()   # caps, side
+    N = cm.vertex_normals
+    w = kernels.recovery_weights(cm, QUALITY_FLOOR)
+    X, rough = kernels.intrinsic_patch_recovery(cm, ft.feature_shape_operator(V, F), N, w)
+    C0, m = smoothing_coefficients(cm, w)
+    args = (C0, m, kernels.transport_phases(cm, N), rough, 5, 1e-6)
+    calls = []
+    orig = kernels.intrinsic_smoothing
+
+    def counted(sub, *a, **k):
+        out = orig(sub, *a, **k)
+        calls.append((sub.n_vertices, out[1]))
+        return out
+    monkeypatch.setattr(kernels, "intrinsic_smoothing", counted)
+    own, scaled = X.copy(), X.copy()
+    intrinsic.adaptive_smoothing_by_parts(cm, own, *args)
+    plain_calls, calls[:] = list(calls), []
+    intrinsic.adaptive_smoothing_by_parts(cm, scaled, *args, scale_groups=np.zeros(len(cut.V), dtype=int))
+    side = int(np.argmax(np.bincount(labels)))
+    caps = [c for c in range(3) if c != side]
+    rms = np.sqrt(np.mean((own ** 2).sum(axis=1)))
+    assert calls[side] == plain_calls[side]                  # the curved side: its own test already
+    for c in caps:
+        assert plain_calls[c][1] > 20 and calls[c][1] <= 5, (plain_calls, calls)
+        cap = labels == c
+        assert np.abs(own[cap]).max() < 1e-9 * rms           # a cap's values: round-off of the part's
+    assert np.abs(scaled - own).max() <= 1e-3 * rms
+    with pytest.raises(ValueError, match="scale_groups"):
+        intrinsic.adaptive_smoothing_by_parts(cm, X.copy(), *args, scale_groups=np.zeros(3, dtype=int))

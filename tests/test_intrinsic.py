@@ -196,3 +196,53 @@ def test_gauss_bonnet_on_real_meshes_not_worse_than_libigl(path):
         return abs(float(np.sum(K[ok] * A[ok])) - 2 * np.pi * chi)
     for r in (5, 2):
         assert err(igl_hhj.principal_curvature(V, F, r)) <= err(igl.principal_curvature(V, F, r))
+
+
+def test_smoothing_by_parts_is_each_parts_own_smoothing():
+    """:func:`igl_hhj.intrinsic.adaptive_smoothing_by_parts` (one compiled call per component,
+    used on the sides of the cut of igl_hhj.features): the parts are the validated sub-meshes
+    (igl_hhj.components.submesh) without recomputing their topology; a component's values are
+    bit for bit those of its own call; the whole agrees with the one-call smoothing to
+    round-off; the components below SPLIT_MIN_VERTICES and an unreferenced vertex go
+    together in one more call."""
+    from igl_hhj import components
+    from igl_hhj.recovery import QUALITY_FLOOR, smoothing_coefficients
+    parts = [_jittered_torus(), icosphere(3), icosphere(1)]                  # 642 and 42 vertices
+    V = np.vstack([parts[0][0], 0.3 * parts[1][0] + 4.0, 0.2 * parts[2][0] - 4.0, [[9.0, 9.0, 9.0]]])
+    offsets = np.cumsum([0] + [len(p[0]) for p in parts])
+    F = np.vstack([p[1] + o for p, o in zip(parts, offsets)])
+    m = TriangleMesh(V, F)
+    N = m.vertex_normals
+    w = kernels.recovery_weights(m, QUALITY_FLOOR)
+    X, rough = kernels.intrinsic_patch_recovery(m, igl_hhj.shape_operator(m), N, w)
+    C0, mass = smoothing_coefficients(m, w)
+    phase = kernels.transport_phases(m, N)
+    args = (C0, mass, phase, rough, 5, 1e-6)
+    X1, Xp = X.copy(), X.copy()
+    one = intrinsic.adaptive_smoothing(m, X1, *args)
+    split = intrinsic.adaptive_smoothing_by_parts(m, Xp, *args)
+    assert one[0] == split[0] == 0 and split[2] == one[2] == 3
+    assert split[1] <= one[1]
+    assert rel(Xp, X1) <= 1e-10
+    np.testing.assert_allclose(split[3], one[3], rtol=1e-10)               # the adaptive radius
+    labels, n = kernels.vertex_components(m)
+    (vo, fo, eo), pieces = components.split_parts(m, labels, n)
+    for c, (sub, v, f, e) in enumerate(pieces):
+        faces = np.flatnonzero(labels[F[:, 0]] == c)
+        ref, verts = components.submesh(m, faces)
+        np.testing.assert_array_equal(fo[f], faces)
+        # the parts' maps have the dtypes of TriangleMesh's (the kernels take them uncopied)
+        assert sub.edges.dtype == sub.edge_faces.dtype == ref.edges.dtype == np.int32
+        assert sub.edge_local_index.dtype == ref.edge_local_index.dtype == np.int8
+        k = len(verts)                     # part 0 also holds the unreferenced vertex, the last
+        np.testing.assert_array_equal(vo[v][:k], verts)
+        assert len(vo[v]) == k + (c == 0)
+        np.testing.assert_array_equal(sub.V[:k], ref.V)
+        for name in ("F", "edges", "edge_faces", "edge_local_index"):
+            np.testing.assert_array_equal(getattr(sub, name), getattr(ref, name), err_msg=name)
+        if len(verts) < intrinsic.SPLIT_MIN_VERTICES:
+            continue
+        alone = X[verts].copy()
+        intrinsic.adaptive_smoothing(ref, alone, C0[faces], mass[verts], phase[eo[e]], rough[verts], 5, 1e-6)
+        np.testing.assert_array_equal(Xp[verts], alone)                    # bit for bit
+    assert rel(Xp[offsets[2]:offsets[3]], X1[offsets[2]:offsets[3]]) <= 1e-10   # the small one, in the last call
