@@ -481,6 +481,35 @@ def test_vertex_stage_bit_identical_across_thread_counts():
     assert np.array_equal(one, two)
 
 
+@pytest.mark.parametrize("parts", [1, 2])
+def test_smoothing_tasks_bit_identical_to_one_pcg(parts):
+    """Below the two-thread sweep size (2k-20k vertices) the smoothing runs the h and z parts
+    of each solve as two tasks on two threads; on one thread one PCG solves both.  The bits
+    and the iteration count must agree (one and several parts)."""
+    from igl_hhj.intrinsic import vertex_stage
+    V0, F0 = _bumpy(4)
+    V, F = V0, F0
+    if parts == 2:
+        V = np.vstack([V0, 0.5 * V0 + 3.0])
+        F = np.vstack([F0, F0 + len(V0)])
+    m = TriangleMesh(V, F)
+    assert 2000 <= m.n_vertices < 20000
+    S = _shape_operator(m, None, None, None, "cg", 1e-10)
+    nt = kernels.max_threads()
+    adapt, kernels.ADAPT_TO_LOAD = kernels.ADAPT_TO_LOAD, False
+    try:
+        kernels.set_num_threads(1)
+        one, _ = vertex_stage(m, S, 5, info=(i1 := {}))
+        kernels.set_num_threads(max(2, nt))
+        two, _ = vertex_stage(m, S, 5, info=(i2 := {}))
+    finally:
+        kernels.set_num_threads(nt)
+        kernels.ADAPT_TO_LOAD = adapt
+    assert i1["components"] == i2["components"] == parts
+    assert i1["smoothing_iterations"] == i2["smoothing_iterations"] > 0
+    assert np.array_equal(one, two)
+
+
 def test_smoothing_of_several_parts_bit_identical_across_thread_counts():
     """The intrinsic smoothing of a mesh with several parts (per-part CG scalars) runs its
     reductions in parallel chunks: the same bits on one and two threads (>= 20k vertices,

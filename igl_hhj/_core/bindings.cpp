@@ -492,11 +492,13 @@ NB_MODULE(_hhj_core, m) {
         {
             nb::gil_scoped_release nogil;
             hhj::ThreadBudget tb(nV);
+            // below the two-thread sweeps' size, h and z as two tasks (the same bits)
+            const int tasks = tb.nt == 1 && tb.free_threads >= 2 && nV >= hhj::SMOOTHING_TASK_MIN ? 2 : 1;
             status = hhj::intrinsic_smoothing(V.data(), F.data(), nF, nV, E.data(), nE, EF.data(), ELI.data(),
                                               C.data(), mass.data(), phase.data(), rough.data(), radius,
                                               per_radius, pilot_radius, pilot_rtol, gain, power, lo, hi, steps,
                                               binom, rtol, maxiter, X.data(), r.data(), tb.nt, &iterations,
-                                              &ngroups);
+                                              &ngroups, tasks);
         }
         return nb::make_tuple(status, iterations, ngroups, to_numpy(std::move(r), {(size_t)nF}));
     });

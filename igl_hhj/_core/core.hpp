@@ -36,11 +36,13 @@ using i8 = std::int8_t;
 struct ThreadBudget {
     static std::atomic<int>& active() { static std::atomic<int> a{0}; return a; }
     int nt = 1;
+    int free_threads = 1;   // the threads this call may use, whatever its size
     // work below min_work runs single-threaded (fork/join costs more than it saves)
     explicit ThreadBudget(i64 work, i64 min_work = 20000) {
         int prev = active().fetch_add(1);
 #ifdef IGL_HHJ_OPENMP
-        nt = (prev == 0 && work >= min_work) ? omp_get_max_threads() : 1;
+        free_threads = prev == 0 ? omp_get_max_threads() : 1;
+        nt = work >= min_work ? free_threads : 1;
 #else
         (void)prev; (void)work; (void)min_work;
 #endif
@@ -56,6 +58,10 @@ constexpr i64 CHUNK = 2048;
 // n·k ≥ PCG_MIN_WORK (measured on the HHJ systems, k = 3: 2 threads are 1.6x slower at
 // 20k unknowns (cheburashka), 8 % slower at 34k (camelhead), 1.5x faster at 123k).
 constexpr i64 PCG_MIN_WORK = 200000;
+
+// The intrinsic smoothing of a mesh with fewer vertices than ThreadBudget's two-thread size
+// runs the h and z parts of each solve as two tasks from this many vertices on.
+constexpr i64 SMOOTHING_TASK_MIN = 2000;
 
 // The corners of every vertex in face order (a counting sort of F): corners of v are
 // corner[start[v] .. start[v + 1]), each f * 3 + c.  Sums over a vertex's corners in this
@@ -239,7 +245,7 @@ int intrinsic_smoothing(const double* V, const i64* F, i64 nF, i64 nV, const i32
                         const double* rough, double radius, double per_radius, double pilot_radius,
                         double pilot_rtol, double gain, double power, double lo, double hi, int steps,
                         const std::vector<double>& binom, double rtol, i64 maxiter, double* X, double* r,
-                        int nt, i64* iterations, i64* ngroups);
+                        int nt, i64* iterations, i64* ngroups, int tasks = 1);
 int smooth_vertex_tensors(i64 nV, const i32* E, i64 nE, const i32* EF, const i8* ELI, const double* C,
                           const double* m, double t, int steps, const std::vector<double>& binom,
                           double rtol, i64 maxiter, double* X, int nt, i64* iterations);

@@ -108,9 +108,15 @@ void reduce_rows(i64 n, const std::int32_t* group, i64 ng, int nt, std::vector<d
 // sweeps per iteration (A p with p.Ap; the update of x and r with r.r and r.(D^-1 r); p).
 // Returns 0 converged, 1 iteration cap, 3 breakdown (non-positive curvature).
 // r, p, q: work vectors of n x 3 (reused across solves: no fresh pages per solve).
-int pcg_hz(const HZSystem& S, const std::int32_t* group, i64 ng, const double* b, double* x,
-           double rtol, i64 maxiter, int nt, i64* its, std::vector<double>& r, std::vector<double>& p,
-           std::vector<double>& q) {
+// PART 2: h and z together (one sweep for both); PART 0: h alone, PART 1: z alone (the
+// other part's entries of x, r, p, q are neither read nor written, and it counts as
+// converged): each part's operations and sums are those of PART 2, so two calls with
+// PART 0 and 1, on two threads, give PART 2's bits.
+template <int PART>
+int pcg_hz_part(const HZSystem& S, const std::int32_t* group, i64 ng, const double* b, double* x,
+                double rtol, i64 maxiter, int nt, i64* its, std::vector<double>& r, std::vector<double>& p,
+                std::vector<double>& q) {
+    constexpr bool H = PART != 1, Z = PART != 0;
     const i64 n = S.n;
     const size_t n3 = (size_t)n * 3;
     const size_t np = (size_t)ng * 2;
@@ -133,9 +139,16 @@ int pcg_hz(const HZSystem& S, const std::int32_t* group, i64 ng, const double* b
         const double d = S.dinv[i];
         const double* ri = &r[3 * i];
         double* pi = &p[3 * i];
-        for (int c = 0; c < 3; ++c) pi[c] = d * ri[c];
-        v[0][0] = ri[0] * ri[0]; v[0][1] = ri[1] * ri[1] + ri[2] * ri[2];
-        v[1][0] = d * v[0][0]; v[1][1] = d * v[0][1];
+        if (H) {
+            pi[0] = d * ri[0];
+            v[0][0] = ri[0] * ri[0];
+            v[1][0] = d * v[0][0];
+        }
+        if (Z) {
+            pi[1] = d * ri[1]; pi[2] = d * ri[2];
+            v[0][1] = ri[1] * ri[1] + ri[2] * ri[2];
+            v[1][1] = d * v[0][1];
+        }
     });
     bool all = true;
     for (size_t k = 0; k < np; ++k) {
@@ -152,15 +165,18 @@ int pcg_hz(const HZSystem& S, const std::int32_t* group, i64 ng, const double* b
             double h = 0.0, zr = 0.0, zi = 0.0;
             for (i64 e = S.indptr[i]; e < S.indptr[i + 1]; ++e) {
                 const double* pc = &p[3 * (i64)S.indices[e]];
-                const double a = S.a[e], c = a * S.pc[e], s = a * S.ps[e];
-                h += a * pc[0];
-                zr += c * pc[1] - s * pc[2];
-                zi += s * pc[1] + c * pc[2];
+                const double a = S.a[e];
+                if (H) h += a * pc[0];
+                if (Z) {
+                    const double c = a * S.pc[e], s = a * S.ps[e];
+                    zr += c * pc[1] - s * pc[2];
+                    zi += s * pc[1] + c * pc[2];
+                }
             }
             double* qi = &q[3 * i];
             const double* pi = &p[3 * i];
-            qi[0] = h; qi[1] = zr; qi[2] = zi;
-            v[0][0] = pi[0] * h; v[0][1] = pi[1] * zr + pi[2] * zi;
+            if (H) { qi[0] = h; v[0][0] = pi[0] * h; }
+            if (Z) { qi[1] = zr; qi[2] = zi; v[0][1] = pi[1] * zr + pi[2] * zi; }
         });
         for (size_t k = 0; k < np; ++k) {
             if (done[k]) { alpha[k] = 0.0; continue; }
@@ -175,11 +191,17 @@ int pcg_hz(const HZSystem& S, const std::int32_t* group, i64 ng, const double* b
             double* ri = &r[3 * i];
             const double* pi = &p[3 * i];
             const double* qi = &q[3 * i];
-            xi[0] += a0 * pi[0]; ri[0] -= a0 * qi[0];
-            xi[1] += a1 * pi[1]; ri[1] -= a1 * qi[1];
-            xi[2] += a1 * pi[2]; ri[2] -= a1 * qi[2];
-            v[0][0] = ri[0] * ri[0]; v[0][1] = ri[1] * ri[1] + ri[2] * ri[2];
-            v[1][0] = d * v[0][0]; v[1][1] = d * v[0][1];
+            if (H) {
+                xi[0] += a0 * pi[0]; ri[0] -= a0 * qi[0];
+                v[0][0] = ri[0] * ri[0];
+                v[1][0] = d * v[0][0];
+            }
+            if (Z) {
+                xi[1] += a1 * pi[1]; ri[1] -= a1 * qi[1];
+                xi[2] += a1 * pi[2]; ri[2] -= a1 * qi[2];
+                v[0][1] = ri[1] * ri[1] + ri[2] * ri[2];
+                v[1][1] = d * v[0][1];
+            }
         });
         all = true;
         for (size_t k = 0; k < np; ++k) {
@@ -197,8 +219,8 @@ int pcg_hz(const HZSystem& S, const std::int32_t* group, i64 ng, const double* b
         for (i64 i = 0; i < n; ++i) {
             const i64 g = gid(i);
             const double d = S.dinv[i];
-            if (!done[2 * g]) p[3 * i] = d * r[3 * i] + beta[2 * g] * p[3 * i];
-            if (!done[2 * g + 1]) {
+            if (H && !done[2 * g]) p[3 * i] = d * r[3 * i] + beta[2 * g] * p[3 * i];
+            if (Z && !done[2 * g + 1]) {
                 p[3 * i + 1] = d * r[3 * i + 1] + beta[2 * g + 1] * p[3 * i + 1];
                 p[3 * i + 2] = d * r[3 * i + 2] + beta[2 * g + 1] * p[3 * i + 2];
             }
@@ -382,7 +404,12 @@ struct HZProblem {
     // matrix lists its entries in the order of the edges, and fill() may sum the diagonal
     // row by row (in parallel) with the bits of the serial scatter over the edges
     bool rows_in_edge_order = true;
+    // 2: every solve runs its h part and its z part as two tasks on two threads (each a
+    // serial PCG: no fork and join per iteration; for meshes too small for two threads per
+    // sweep); 1: one PCG for both, its sweeps on nt threads
+    int tasks = 1;
     std::vector<double> Y, R, AY, dY, acc, wr, wp, wq;    // work vectors of run()
+    std::vector<double> dYz, wr2, wp2, wq2;               // the z task's (tasks = 2)
 
     HZProblem(i64 nV, const i32* E_, i64 nE_, const i32* EF_, const i8* ELI_, const double* C0_,
               const double* m_, const double* phase)
@@ -464,8 +491,7 @@ struct HZProblem {
 #endif
                 for (i64 q = 0; q < n3; ++q) R[q] = m[q / 3] * Y[q] - AY[q];
                 i64 its = 0;
-                const int status = pcg_hz(S, label.data(), ngroups, R.data(), dY.data(), rtol, maxiter, nt, &its,
-                                          wr, wp, wq);
+                const int status = solve(R.data(), dY.data(), rtol, maxiter, nt, &its);
                 *iterations += its;
                 if (status != 0) return status;
                 const double bj = binom[j];
@@ -483,10 +509,38 @@ struct HZProblem {
         return 0;
     }
 
+    // dY = A^-1 R: one PCG for h and z, or (tasks = 2) the two parts on two threads, with
+    // the same bits; its = the larger part's iterations, as the one PCG counts them
+    int solve(const double* Rv, double* dYv, double rtol, i64 maxiter, int nt, i64* its) {
+        if (tasks < 2)
+            return pcg_hz_part<2>(S, label.data(), ngroups, Rv, dYv, rtol, maxiter, nt, its, wr, wp, wq);
+        const i64 n3 = S.n * 3;
+        dYz.resize((size_t)n3);
+        int st_h = 0, st_z = 0;
+        i64 it_h = 0, it_z = 0;
+#ifdef IGL_HHJ_OPENMP
+#pragma omp parallel sections num_threads(2)
+#endif
+        {
+#ifdef IGL_HHJ_OPENMP
+#pragma omp section
+#endif
+            st_h = pcg_hz_part<0>(S, label.data(), ngroups, Rv, dYv, rtol, maxiter, 1, &it_h, wr, wp, wq);
+#ifdef IGL_HHJ_OPENMP
+#pragma omp section
+#endif
+            st_z = pcg_hz_part<1>(S, label.data(), ngroups, Rv, dYz.data(), rtol, maxiter, 1, &it_z, wr2, wp2,
+                                  wq2);
+        }
+        for (i64 i = 0; i < S.n; ++i) { dYv[3 * i + 1] = dYz[3 * i + 1]; dYv[3 * i + 2] = dYz[3 * i + 2]; }
+        *its = std::max(it_h, it_z);
+        return st_h != 0 ? st_h : st_z;
+    }
+
     // frees the work vectors (between the pilot and the final smoothing, so that the
     // adaptive radius's temporaries do not add to them: the memory peak stays that of a solve)
     void release_work() {
-        for (auto* v : {&Y, &R, &AY, &dY, &acc, &wr, &wp, &wq}) std::vector<double>().swap(*v);
+        for (auto* v : {&Y, &R, &AY, &dY, &acc, &wr, &wp, &wq, &dYz, &wr2, &wp2, &wq2}) std::vector<double>().swap(*v);
     }
 };
 
@@ -501,8 +555,9 @@ int intrinsic_smoothing(const double* V, const i64* F, i64 nF, i64 nV, const i32
                         const double* rough, double radius, double per_radius, double pilot_radius,
                         double pilot_rtol, double gain, double power, double lo, double hi, int steps,
                         const std::vector<double>& binom, double rtol, i64 maxiter, double* X, double* r,
-                        int nt, i64* iterations, i64* ngroups_out) {
+                        int nt, i64* iterations, i64* ngroups_out, int tasks) {
     HZProblem P(nV, E, nE, EF, ELI, C0, m, phase);
+    P.tasks = tasks;
     *ngroups_out = P.ngroups;
     *iterations = 0;
     std::vector<double> t(nF), pilot(X, X + (size_t)nV * 3);
