@@ -17,7 +17,10 @@ bad inputs instead of raising (measured with libigl 2.6.3):
 * an ``.off`` face line claiming 2·10⁹ corners in a 45-byte file: 15.7 GB
   of memory, then ``std::bad_alloc``;
 * an ascii ``.ply`` with a non-numeric token: uninitialised indices;
-* ``.obj`` faces written 0-based: index -1 after libigl's 1-based shift.
+* ``.obj`` faces written 0-based: index -1 after libigl's 1-based shift;
+* a ``.ply`` header declaring a property or an element twice, or an ascii face
+  line without the values of a second list property (``texcoord``): the
+  process aborts (``free(): double free``).
 
 :func:`read_mesh` therefore checks existence, regular file, readability and
 extension, then checks *every* count and token of the body before libigl
@@ -522,7 +525,17 @@ _PLY_INT_TYPES = ("char", "int8", "uchar", "uint8", "short", "int16", "ushort", 
 def _check_ply_properties(path, elements):
     """Known property types, vertex x/y/z and face vertex_indices (libigl's PLY reader
     segfaults when they are missing)."""
+    seen = set()
     for name, _, props in elements:
+        if name in seen:
+            raise MeshFileError(f"{path}: corrupt PLY header: element {name!r} is declared twice "
+                                f"(libigl's PLY reader aborts on that)")
+        seen.add(name)
+        names = [pname for pname, _ in props]
+        twice = sorted({pname for pname in names if names.count(pname) > 1})
+        if twice:
+            raise MeshFileError(f"{path}: corrupt PLY header: element {name!r} declares property "
+                                f"{twice[0]!r} more than once (libigl's PLY reader aborts on that)")
         for pname, types in props:
             scalar = types[1:] if types and types[0] == "list" else types
             if not scalar or any(t not in _PLY_SIZES for t in scalar) or                     (types[0] == "list" and (len(types) != 3 or types[1] not in _PLY_INT_TYPES)):
@@ -629,16 +642,43 @@ def _check_ply(path, head, size):
             _check_rows(path, L, rows, L.maxlen[rows] >= 10,
                         f"face line has a vertex index of 10 or more digits (the header declares "
                         f"{counts.get('vertex', 0)} vertices)")
-            if lists == [p for p, _ in props if p in ("vertex_indices", "vertex_index")]:
+            if len(lists) == 1 and lists == [p for p, _ in props if p in ("vertex_indices", "vertex_index")]:
                 want = 1 + k + (len(props) - len(lists))
                 _check_rows(path, L, rows, L.ntok[rows] != want,
                             "face line does not have the values its properties need (its corner "
                             "count, that many indices, one value per other property)")
+            else:           # more list properties (texture coordinates...): line by line
+                _check_ascii_ply_lists(path, L, rows, props)
         elif not lists and n:
             _check_rows(path, L, rows, L.ntok[rows] != len(props),
                         f"{name} line does not have the {len(props)} values its properties need")
         start += n
     return None if sizes is None or (sizes == 3).all() else sizes
+
+
+def _check_ascii_ply_lists(path, L, rows, props):
+    """Each line of an ascii PLY element with several list properties must hold exactly
+    the values its properties need, each list its count and that many values (libigl's
+    reader aborts otherwise).  A pass over those lines in Python."""
+    with open(path, "rb") as fh:
+        for row in range(rows.start, rows.stop):
+            fh.seek(int(L.offset[row]))
+            tok = fh.readline().split()
+            at = 0
+            for _, types in props:
+                if types[0] != "list":
+                    at += 1
+                    continue
+                count = int(float(tok[at])) if at < len(tok) else -1
+                if count < 0 or float(tok[at]) != count:
+                    at = len(tok) + 1
+                    break
+                at += 1 + count
+            if at != len(tok):
+                mask = np.zeros(len(L), dtype=bool)
+                mask[row] = True
+                _first_bad(path, L, mask, "face line does not have the values its properties need "
+                                          "(each list its count and that many values)")
 
 
 def _ply_element_props(elements):

@@ -211,6 +211,21 @@ FILES = {   # name: (content, exit code, message)
     # an index from 2³¹ on overflows libigl's ascii PLY reader (abort); found by the fuzzer
     "huge_index.ply": (_ply(b"0 0 0\n1 0 0\n0 1 0\n3 0 1 2147483648\n"), 3,
                        "vertex index of 10 or more digits"),
+    # libigl aborts (double free) on a property or element declared twice, and on an ascii
+    # face line that lacks the values of a second list property; found by the fuzzer
+    "twice.ply": (b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                  b"property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+                  b"property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n"
+                  b"3 0 1 2 3 0 1 2\n", 3, "declares property 'vertex_indices' more than once"),
+    "element_twice.ply": (_ply(b"0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 2\n").replace(
+        b"end_header", b"element face 1\nproperty list uchar int vertex_indices\nend_header"), 3,
+        "element 'face' is declared twice"),
+    "short_list.ply": (_ply(b"0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n").replace(
+        b"end_header", b"property list uchar float texcoord\nend_header"), 3,
+        "each list its count and that many values"),
+    # a second list property with its values reads fine: accepted
+    "texcoord.ply": (_ply(b"0 0 0\n1 0 0\n0 1 0\n3 0 1 2 6 0 0 1 0 0 1\n").replace(
+        b"end_header", b"property list uchar float texcoord\nend_header"), 0, ""),
     # normals of mixed types read fine: accepted
     "mixed_normals.ply": (b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
                           b"property float z\nproperty float nx\nproperty double ny\nproperty float nz\n"
