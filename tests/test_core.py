@@ -355,19 +355,12 @@ def test_gathered_vertex_kernels_bit_identical_across_thread_counts():
     N = m.vertex_normals
     w = kernels.recovery_weights(m, rc.QUALITY_FLOOR)
     P = np.random.default_rng(1).normal(size=(m.n_vertices, 3))
-    nt = kernels.max_threads()
-    adapt, kernels.ADAPT_TO_LOAD = kernels.ADAPT_TO_LOAD, False
-    out = []
-    try:
-        for k in (1, max(2, nt)):
-            kernels.set_num_threads(k)
-            Xi, rough = kernels.intrinsic_patch_recovery(m, S, N, w)
-            out.append((kernels.patch_recovery(m, S, N, w), Xi, rough,
-                        kernels.adaptive_radius(m, P, rough, 5.0, 0.3, 0.25, 0.2, 5.0)))
-    finally:
-        kernels.set_num_threads(nt)
-        kernels.ADAPT_TO_LOAD = adapt
-    for a, b in zip(*out):
+
+    def kernels_once():
+        Xi, rough = kernels.intrinsic_patch_recovery(m, S, N, w)
+        return (kernels.patch_recovery(m, S, N, w), Xi, rough,
+                kernels.adaptive_radius(m, P, rough, 5.0, 0.3, 0.25, 0.2, 5.0))
+    for a, b in zip(*_on_one_and_two_threads(kernels_once)):
         assert np.array_equal(a, b)
 
 
@@ -481,12 +474,37 @@ def test_vertex_stage_bit_identical_across_thread_counts():
     assert np.array_equal(one, two)
 
 
+def _on_one_and_two_threads(fn):
+    """[fn() on one thread, fn() on two] (the load adaptation off)."""
+    nt = kernels.max_threads()
+    adapt, kernels.ADAPT_TO_LOAD = kernels.ADAPT_TO_LOAD, False
+    try:
+        out = []
+        for k in (1, max(2, nt)):
+            kernels.set_num_threads(k)
+            out.append(fn())
+        return out
+    finally:
+        kernels.set_num_threads(nt)
+        kernels.ADAPT_TO_LOAD = adapt
+
+
+def _vertex_stage_on_one_and_two_threads(m):
+    """intrinsic.vertex_stage at radius 5 on one thread, then on two: [(X, info)] * 2."""
+    from igl_hhj.intrinsic import vertex_stage
+    S = _shape_operator(m, None, None, None, "cg", 1e-10)
+
+    def stage():
+        X, _ = vertex_stage(m, S, 5, info=(info := {}))
+        return X, info
+    return _on_one_and_two_threads(stage)
+
+
 @pytest.mark.parametrize("parts", [1, 2])
 def test_smoothing_tasks_bit_identical_to_one_pcg(parts):
     """Below the two-thread sweep size (2k-20k vertices) the smoothing runs the h and z parts
     of each solve as two tasks on two threads; on one thread one PCG solves both.  The bits
     and the iteration count must agree (one and several parts)."""
-    from igl_hhj.intrinsic import vertex_stage
     V0, F0 = _bumpy(4)
     V, F = V0, F0
     if parts == 2:
@@ -494,17 +512,7 @@ def test_smoothing_tasks_bit_identical_to_one_pcg(parts):
         F = np.vstack([F0, F0 + len(V0)])
     m = TriangleMesh(V, F)
     assert 2000 <= m.n_vertices < 20000
-    S = _shape_operator(m, None, None, None, "cg", 1e-10)
-    nt = kernels.max_threads()
-    adapt, kernels.ADAPT_TO_LOAD = kernels.ADAPT_TO_LOAD, False
-    try:
-        kernels.set_num_threads(1)
-        one, _ = vertex_stage(m, S, 5, info=(i1 := {}))
-        kernels.set_num_threads(max(2, nt))
-        two, _ = vertex_stage(m, S, 5, info=(i2 := {}))
-    finally:
-        kernels.set_num_threads(nt)
-        kernels.ADAPT_TO_LOAD = adapt
+    (one, i1), (two, i2) = _vertex_stage_on_one_and_two_threads(m)
     assert i1["components"] == i2["components"] == parts
     assert i1["smoothing_iterations"] == i2["smoothing_iterations"] > 0
     assert np.array_equal(one, two)
@@ -514,24 +522,13 @@ def test_smoothing_of_several_parts_bit_identical_across_thread_counts():
     """The intrinsic smoothing of a mesh with several parts (per-part CG scalars) runs its
     reductions in parallel chunks: the same bits on one and two threads (>= 20k vertices,
     where the kernel takes two)."""
-    from igl_hhj.intrinsic import vertex_stage
     from igl_hhj.surfaces import icosphere
     V0, F0 = icosphere(5)
     V = np.vstack([V0, 0.5 * V0 * [1.0, 0.8, 0.6] + 3.0])
     F = np.vstack([F0, F0 + len(V0)])
     m = TriangleMesh(V, F)
     assert m.n_vertices >= 20000
-    S = _shape_operator(m, None, None, None, "cg", 1e-10)
-    nt = kernels.max_threads()
-    adapt, kernels.ADAPT_TO_LOAD = kernels.ADAPT_TO_LOAD, False
-    try:
-        kernels.set_num_threads(1)
-        one, _ = vertex_stage(m, S, 5, info=(i1 := {}))
-        kernels.set_num_threads(max(2, nt))
-        two, _ = vertex_stage(m, S, 5, info=(i2 := {}))
-    finally:
-        kernels.set_num_threads(nt)
-        kernels.ADAPT_TO_LOAD = adapt
+    (one, i1), (two, i2) = _vertex_stage_on_one_and_two_threads(m)
     assert i1["components"] == i2["components"] == 2
     assert np.array_equal(one, two)
 

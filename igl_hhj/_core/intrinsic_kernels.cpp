@@ -430,6 +430,16 @@ struct HZProblem {
         S.dinv.resize(nV);
     }
 
+    // w_e = sum over the edge's faces of C0[f, i] t_f
+    double edge_weight(i64 e, const double* t) const {
+        double we = 0.0;
+        for (int s = 0; s < 2; ++s) {
+            const i64 f = EF[2 * e + s];
+            if (f >= 0) we += C0[3 * f + ELI[2 * e + s]] * t[f];
+        }
+        return we;
+    }
+
     void fill(const double* t, int nt) {
         const i64 nV = S.n;
         if (rows_in_edge_order) {
@@ -438,11 +448,7 @@ struct HZProblem {
 #pragma omp parallel for schedule(static) num_threads(nt)
 #endif
             for (i64 e = 0; e < nE; ++e) {
-                double we = 0.0;
-                for (int s = 0; s < 2; ++s) {
-                    const i64 f = EF[2 * e + s];
-                    if (f >= 0) we += C0[3 * f + ELI[2 * e + s]] * t[f];
-                }
+                const double we = edge_weight(e, t);
                 S.a[pos_lo[e]] = -we;
                 S.a[pos_hi[e]] = -we;
             }
@@ -461,11 +467,7 @@ struct HZProblem {
         }
         for (i64 v = 0; v < nV; ++v) S.a[diag_pos[v]] = m[v];
         for (i64 e = 0; e < nE; ++e) {
-            double we = 0.0;
-            for (int s = 0; s < 2; ++s) {
-                const i64 f = EF[2 * e + s];
-                if (f >= 0) we += C0[3 * f + ELI[2 * e + s]] * t[f];
-            }
+            const double we = edge_weight(e, t);
             S.a[pos_lo[e]] = -we;
             S.a[pos_hi[e]] = -we;
             S.a[diag_pos[E[2 * e]]] += we;
