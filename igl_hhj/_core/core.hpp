@@ -56,8 +56,9 @@ constexpr i64 CHUNK = 2048;
 
 // The block PCG forks and joins several times per iteration: two threads only pay from
 // n·k ≥ PCG_MIN_WORK (measured on the HHJ systems, k = 3: 2 threads are 1.6x slower at
-// 20k unknowns (cheburashka), 8 % slower at 34k (camelhead), 1.5x faster at 123k).
-constexpr i64 PCG_MIN_WORK = 200000;
+// 20k unknowns (cheburashka), 8 % slower at 34k (camelhead; the same time in a later
+// round), 1.15x faster at 58k (beetle: shape_operator 137 -> 119 ms), 1.5x faster at 123k).
+constexpr i64 PCG_MIN_WORK = 150000;
 
 // The intrinsic smoothing of a mesh with fewer vertices than ThreadBudget's two-thread size
 // runs the h and z parts of each solve as two tasks from this many vertices on.
