@@ -244,20 +244,24 @@ class TriangleMesh:
     def __init__(self, V, F, *, copy=True):
         V = validate_vertices(V)
         F = validate_faces(F, V.shape[0])
-        # read-only copies: nothing can change the arrays after validation.  copy=False
-        # (a mesh private to one call, e.g. the drop-in's): read-only views of V and F when
-        # they already are C-contiguous float64 / int64 (memory: 36 B/face less)
+        self._set_arrays(V, F, copy)
+        self._check_degenerate()
+        self._check_manifold_and_orientation()
+        self._warn_unwelded()
+        # the (#F, 3, 3) edge vectors are recomputed on demand (memory: 72 B/face)
+        self.__dict__.pop("_edge_vectors", None)
+
+    def _set_arrays(self, V, F, copy):
+        """``self.V``, ``self.F`` read-only: nothing can change the arrays after validation.
+        Copies, or with ``copy=False`` (a mesh private to one call, e.g. the drop-in's)
+        read-only views of V and F when they already are C-contiguous float64 / int64
+        (memory: 36 B/face less)."""
         self.V = np.array(V, dtype=np.float64, order="C", copy=None if not copy else True)
         self.F = np.array(F, dtype=np.int64, order="C", copy=None if not copy else True)
         if not copy:
             self.V, self.F = self.V.view(), self.F.view()
         self.V.setflags(write=False)
         self.F.setflags(write=False)
-        self._check_degenerate()
-        self._check_manifold_and_orientation()
-        self._warn_unwelded()
-        # the (#F, 3, 3) edge vectors are recomputed on demand (memory: 72 B/face)
-        self.__dict__.pop("_edge_vectors", None)
 
     @classmethod
     def _same_faces(cls, mesh, V, F):
@@ -267,12 +271,9 @@ class TriangleMesh:
         edge-manifold mesh, as :func:`igl_hhj.features.cut_along` does).  The per-face
         metrics of ``mesh`` are reused: they depend only on the corner positions."""
         self = cls.__new__(cls)
-        self.V = np.array(V, dtype=np.float64, order="C")
-        self.F = np.array(F, dtype=np.int64, order="C")
+        self._set_arrays(V, F, copy=True)
         if self.F.shape != mesh.F.shape:
             raise ValueError(f"_same_faces: F must have the shape {mesh.F.shape}, got {self.F.shape}")
-        self.V.setflags(write=False)
-        self.F.setflags(write=False)
         for key in ("_cross", "face_double_areas", "face_areas", "face_normals", "edge_lengths"):
             if key in mesh.__dict__:
                 self.__dict__[key] = mesh.__dict__[key]
@@ -285,15 +286,12 @@ class TriangleMesh:
         validated mesh; the arrays must be what :attr:`edges`, :attr:`edge_faces` and
         :attr:`edge_local_index` would compute)."""
         self = cls.__new__(cls)
-        self.V = np.ascontiguousarray(V, dtype=np.float64)
-        self.F = np.ascontiguousarray(F, dtype=np.int64)
+        self._set_arrays(V, F, copy=False)      # the parts' own slices of split_parts' arrays
         for name, a, dtype in (("edges", edges, np.int32), ("edge_faces", edge_faces, np.int32),
                                ("edge_local_index", edge_local_index, np.int8)):
             a = np.ascontiguousarray(a, dtype=dtype)      # the dtypes of the topology maps
             a.setflags(write=False)
             self.__dict__[name] = a
-        self.V.setflags(write=False)
-        self.F.setflags(write=False)
         return self
 
     # ------------------------------------------------------------------ sizes
