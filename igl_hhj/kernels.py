@@ -534,6 +534,8 @@ def graph_components(pairs, n):
     ``(labels (n,) int32, count)``, labelled in the order of their smallest node (the
     labels of ``scipy.sparse.csgraph.connected_components``), every node its own
     component unless an edge joins it (one union-find pass, as :func:`vertex_components`)."""
+    if n >= 2**31:                                     # before anything of size n is allocated
+        raise ValueError("graph_components: at most 2**31 - 1 nodes (the core's labels are int32)")
     pairs = _i64(pairs)
     if pairs.ndim != 2 or pairs.shape[1] != 2:
         raise ValueError("graph_components: pairs must be (k, 2)")
@@ -542,8 +544,6 @@ def graph_components(pairs, n):
     alone = np.ones(n, dtype=bool)                     # nodes of no edge: a loop each, so that
     alone[pairs.ravel()] = False                       # each is its own component
     loops = np.flatnonzero(alone)
-    if n >= 2**31:
-        raise ValueError("graph_components: at most 2**31 - 1 nodes")
     return _core.vertex_components(_i32(np.concatenate([pairs, np.stack([loops, loops], axis=1)])), int(n))
 
 

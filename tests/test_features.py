@@ -446,6 +446,8 @@ def test_corner_components_are_scipys():
     np.testing.assert_array_equal(label, ref)
     with pytest.raises(ValueError, match="out of range"):
         kernels.graph_components([[0, n]], n)
+    with pytest.raises(ValueError, match="at most 2"):         # refused before any allocation
+        kernels.graph_components(np.zeros((0, 2), dtype=np.int64), 2**31)
 
 
 def test_side_tolerance_in_the_units_of_the_part(monkeypatch):
