@@ -6,6 +6,7 @@ rejected one gets a message naming the cause and the fix.
 from __future__ import annotations
 
 import os
+import re
 import signal
 import struct
 import subprocess
@@ -247,6 +248,20 @@ def test_file_guards_bound_memory_and_time(tmp_path):
     for rec, (code, message) in zip(run_capped(jobs, extra_mb=300, seconds=20), expect):
         assert check_outcome(rec, {code}) == code
         assert message in rec["err"] and rec["seconds"] < 10
+
+
+@pytest.mark.parametrize("name", ["twice.ply", "element_twice.ply", "short_list.ply"])
+def test_ply_headers_libigl_aborts_on_raise_in_process(tmp_path, name):
+    """The PLYs on which libigl's reader aborts are refused by read_mesh itself (a
+    MeshFileError, a ValueError, naming the problem), before libigl sees them."""
+    from igl_hhj.mesh_io import MeshFileError, read_mesh
+    content, _, message = FILES[name]
+    (tmp_path / name).write_bytes(content)
+    with pytest.raises(MeshFileError, match=re.escape(message)):
+        read_mesh(tmp_path / name)
+    (tmp_path / "ok.ply").write_bytes(FILES["texcoord.ply"][0])
+    V, F = read_mesh(tmp_path / "ok.ply")[:2]
+    assert F.shape == (1, 3)
 
 
 def test_long_ply_header_reads():
