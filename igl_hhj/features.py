@@ -50,7 +50,7 @@ from .mesh import TriangleMesh, _as_array, as_mesh
 __all__ = [
     "DEFAULT_FEATURE_ANGLE", "dihedral_angles", "crease_edges", "crease_network", "CreaseNetwork",
     "cut_along", "CutMesh", "feature_shape_operator", "feature_principal_curvature",
-    "FeatureCurvature", "check_feature_angle",
+    "FeatureCurvature", "check_feature_angle", "dihedral_magnitudes_reference", "cut_along_reference",
 ]
 
 DEFAULT_FEATURE_ANGLE = 40.0
@@ -82,33 +82,36 @@ def dihedral_angles(mesh: TriangleMesh) -> NDArray[np.float64]:
     -------
     theta : (#E,) float64, in mesh.edges order; 0 on boundary edges.
     """
-    theta, (inner, f1, n0) = _dihedral_magnitudes(mesh)
+    theta = _dihedral_magnitudes(mesh)
+    inner = np.flatnonzero(mesh.edge_face_count == 2)
     take = np.take
-    far = take(mesh.V, mesh.F[f1, take(mesh.edge_local_index[:, 1], inner)], axis=0)  # corner opposite e in face 1
+    ef = take(mesh.edge_faces, inner, axis=0)
+    n0 = take(mesh.face_normals, ef[:, 0], axis=0)
+    far = take(mesh.V, mesh.F[ef[:, 1], take(mesh.edge_local_index[:, 1], inner)], axis=0)  # corner opposite e in face 1
     side = np.einsum("ma,ma->m", n0, far - take(mesh.V, take(mesh.edges[:, 0], inner), axis=0))
     theta[inner] = np.where(side > 0, -theta[inner], theta[inner])
     return theta
 
 
-def _dihedral_magnitudes(mesh):
-    """``|θ_e|`` of :func:`dihedral_angles` (#E,) (all the crease test needs), and the inner
-    edges, the faces on their side 1 and the normals of side 0 (for the sign)."""
+def _dihedral_magnitudes(mesh, reference=False):
+    """``|θ_e|`` of :func:`dihedral_angles` (#E,) (all the crease test needs; compiled,
+    :func:`igl_hhj.kernels.dihedral_magnitudes`, or ``reference``: :func:`dihedral_magnitudes_reference`)."""
+    if reference:
+        return dihedral_magnitudes_reference(mesh)
+    return kernels.dihedral_magnitudes(mesh)
+
+
+def dihedral_magnitudes_reference(mesh: TriangleMesh) -> NDArray[np.float64]:
+    """Numpy reference of :func:`igl_hhj.kernels.dihedral_magnitudes`: ``|θ_e| =
+    atan2(|ν_0 × ν_1|, ν_0 · ν_1)`` (#E,) of the normals of the two faces of every inner
+    edge, 0 on boundary (and non-manifold) edges."""
     theta = np.zeros(mesh.n_edges)
     inner = np.flatnonzero(mesh.edge_face_count == 2)
     take = np.take                   # rows by np.take: several times faster than fancy indexing
     ef = take(mesh.edge_faces, inner, axis=0)
-    f1 = ef[:, 1]
-    n0, n1 = take(mesh.face_normals, ef[:, 0], axis=0), take(mesh.face_normals, f1, axis=0)
-    # |ν_0 × ν_1| and ν_0 · ν_1 by components, in the order of np.cross, np.linalg.norm and einsum
-    a0, a1, a2, b0, b1, b2 = n0[:, 0], n0[:, 1], n0[:, 2], n1[:, 0], n1[:, 1], n1[:, 2]
-    c = a1 * b2 - a2 * b1
-    s = c * c
-    c = a2 * b0 - a0 * b2
-    s += c * c
-    c = a0 * b1 - a1 * b0
-    s += c * c
-    theta[inner] = np.arctan2(np.sqrt(s), np.einsum("ma,ma->m", n0, n1))
-    return theta, (inner, f1, n0)
+    n0, n1 = take(mesh.face_normals, ef[:, 0], axis=0), take(mesh.face_normals, ef[:, 1], axis=0)
+    theta[inner] = np.arctan2(np.linalg.norm(np.cross(n0, n1), axis=1), np.einsum("ma,ma->m", n0, n1))
+    return theta
 
 
 def _edge_index(mesh, pairs, name):
@@ -257,7 +260,7 @@ class CutMesh:
     parent: NDArray[np.int64]
 
 
-def cut_along(mesh: TriangleMesh, crease: NDArray[np.bool_]) -> CutMesh:
+def cut_along(mesh: TriangleMesh, crease: NDArray[np.bool_], *, reference: bool = False) -> CutMesh:
     """Duplicate every vertex once per side of the creases through it.
 
     The sides of a vertex are the connected components of its corners, two corners
@@ -266,9 +269,24 @@ def cut_along(mesh: TriangleMesh, crease: NDArray[np.bool_]) -> CutMesh:
     (:func:`igl_hhj.kernels.graph_components`, union-find) finds them at once.  A vertex
     on no crease (or at the end of one) keeps one side and its index.
 
+    Compiled (:func:`igl_hhj.kernels.crease_cut`: one union-find over the corners and the
+    numbering in one pass); ``reference=True``: the numpy reference
+    :func:`cut_along_reference` (the same arrays, tests/test_features.py).
+
     ``igl.cut_mesh`` was not used: on a cube cut along its 12 edges it returns 28
     vertices instead of 24 (it cuts to disk topology).
     """
+    if reference:
+        return cut_along_reference(mesh, crease)
+    nV = mesh.n_vertices
+    Fc, extra = kernels.crease_cut(mesh, (mesh.edge_face_count == 2) & ~crease)
+    par = np.concatenate([np.arange(nV), extra])
+    return CutMesh(V=np.take(mesh.V, par, axis=0), F=Fc, parent=par)
+
+
+def cut_along_reference(mesh: TriangleMesh, crease: NDArray[np.bool_]) -> CutMesh:
+    """Numpy reference of :func:`cut_along` (corner graph by
+    :func:`igl_hhj.kernels.graph_components`, the numbering by ``np.lexsort``)."""
     F = mesh.F
     nF, nV = mesh.n_faces, mesh.n_vertices
     keep = np.flatnonzero((mesh.edge_face_count == 2) & ~crease)
@@ -326,7 +344,7 @@ def _prepare(V, F, feature_angle, crease_edges_, boundary, data):
         raise ValueError(f"feature_angle / crease_edges need boundary='estimate' (each side of a crease "
                          f"is clamped with its estimated normals), got boundary={boundary!r}")
     # the crease test needs |θ_e| only; the signs are for the crease network (crease_network)
-    crease = crease_edges(mesh, feature_angle, edges=crease_edges_, theta=_dihedral_magnitudes(mesh)[0])
+    crease = crease_edges(mesh, feature_angle, edges=crease_edges_, theta=_dihedral_magnitudes(mesh))
     cut, cm = _cut_mesh(mesh, crease)
     return mesh, (crease, None), cut, cm
 

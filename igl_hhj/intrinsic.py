@@ -444,11 +444,16 @@ def adaptive_smoothing_by_parts(mesh: TriangleMesh, X, C0, mass, phase, rough, r
     Xp, C0p, php = (np.take(A, o, axis=0) for A, o in ((X, vo), (C0, fo), (phase, eo)))
     mp, rp = np.take(mass, vo), np.take(rough, vo)
     r = np.empty(mesh.n_faces)
+
+    def solve(c):
+        sub, v, f, e = parts[c]                       # Xp[v]: a contiguous view, smoothed in place
+        return adaptive_smoothing(sub, Xp[v], C0p[f], mp[v], php[e], rp[v], radius, rtol, maxiter,
+                                  solve_rtol=tol[c])
+
+    # the parts are independent: on several threads at once (kernels.run_tasks; the same bits)
     its = 0
-    for c, (sub, v, f, e) in enumerate(parts):
-        x = Xp[v]                                     # a contiguous view: smoothed in place
-        status, k, _, rf = adaptive_smoothing(sub, x, C0p[f], mp[v], php[e], rp[v], radius, rtol, maxiter,
-                                              solve_rtol=tol[c])
+    results = kernels.run_tasks(solve, range(len(parts)), [p[0].n_vertices for p in parts])
+    for (status, k, _, rf), (_, _, f, _) in zip(results, parts):
         if status != 0:
             return status, its, n, r
         r[fo[f]] = rf

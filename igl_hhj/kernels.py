@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import functools
 import os
+import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -46,7 +47,8 @@ __all__ = [
     "set_num_threads", "ell_indptr", "edge_morton_order", "recovery_weights", "patch_recovery",
     "tangent_projection6", "smooth_vertex_tensors", "face_metrics", "vertex_area_sums",
     "intrinsic_patch_recovery", "vertex_components", "transport_phases",
-    "adaptive_radius", "principal_hz", "intrinsic_smoothing",
+    "adaptive_radius", "principal_hz", "intrinsic_smoothing", "dihedral_magnitudes", "crease_cut",
+    "run_tasks", "task_workers",
     "large_call_heap", "with_large_call_heap", "LARGE_CALL_HEAP",
 ]
 
@@ -113,6 +115,71 @@ def _threads():
     if ADAPT_TO_LOAD and n > 1 and _machine_busy():
         n = 1
     _core.set_num_threads(n)
+
+
+# kernel calls that are independent of each other (the sides of a cut mesh) run on this
+# many Python threads at most; each call then runs single-threaded (ThreadBudget: a kernel
+# started while another one runs gets one thread), so the cores are never oversubscribed
+_TASK_POOL: list[Any] = []
+# a task pool pays only from this much work in all (vertices): below it the calls take
+# less than the threads' hand-over costs (~50 µs a task)
+TASKS_MIN_WORK = 4000
+
+
+def task_workers() -> int:
+    """How many independent kernel calls may run at once: the thread policy of
+    :func:`_threads` (``OMP_NUM_THREADS`` or :func:`set_num_threads`, one while the machine
+    is busy)."""
+    n = _USER_THREADS
+    if ADAPT_TO_LOAD and n > 1 and _machine_busy():
+        n = 1
+    return n
+
+
+def run_tasks(fn: Callable[[Any], _R], items, sizes) -> list[_R]:
+    """``[fn(x) for x in items]``, concurrently on up to :func:`task_workers` threads.
+
+    ``fn`` must release the GIL for its work (the compiled kernels do) and its calls must
+    not depend on each other's results.  ``sizes`` (one number per item, its work) orders
+    the start: largest first, so the longest call does not start last (LPT scheduling).
+    Each kernel call inside runs single-threaded, and a kernel's bits do not depend on its
+    thread count, so the results are those of the serial loop, bit for bit.  Serial when
+    one worker is allowed, for one item, or below :data:`TASKS_MIN_WORK` in all.  An
+    exception is raised as from the serial loop (the first item's that raised, in order).
+    """
+    items = list(items)
+    workers = min(task_workers(), len(items))
+    if workers <= 1 or float(np.sum(sizes)) < TASKS_MIN_WORK:
+        return [fn(x) for x in items]
+    if not _TASK_POOL:
+        from concurrent.futures import ThreadPoolExecutor   # lazily: most calls never need it
+        _TASK_POOL.append(ThreadPoolExecutor(max_workers=max(1, _CPU_COUNT - 1), thread_name_prefix="igl_hhj"))
+    pool = _TASK_POOL[0]
+    order = np.argsort(-np.asarray(sizes, dtype=np.float64), kind="stable")
+    # `workers` chains of calls: no more kernels at once than the policy allows
+    queue = list(order[::-1])
+    lock = threading.Lock()
+    out: list[Any] = [None] * len(items)
+
+    def chain():
+        while True:
+            with lock:
+                if not queue:
+                    return
+                i = int(queue.pop())
+            try:
+                out[i] = (True, fn(items[i]))
+            except BaseException as exc:  # re-raised below, in item order
+                out[i] = (False, exc)
+
+    futures = [pool.submit(chain) for _ in range(workers - 1)]
+    chain()                                       # the caller runs one chain itself
+    for future in futures:
+        future.result()
+    for ok, value in out:
+        if not ok:
+            raise value
+    return [value for _, value in out]
 
 
 # Heap policy of a large call (glibc; see igl_hhj/_core/heap.cpp).  glibc raises its mmap
@@ -545,6 +612,25 @@ def graph_components(pairs, n):
     alone[pairs.ravel()] = False                       # each is its own component
     loops = np.flatnonzero(alone)
     return _core.vertex_components(_i32(np.concatenate([pairs, np.stack([loops, loops], axis=1)])), int(n))
+
+
+def dihedral_magnitudes(mesh):
+    """``|θ_e|`` (#E,) of every edge with two faces (0 on the others); reference
+    :func:`igl_hhj.features.dihedral_magnitudes_reference`."""
+    _threads()
+    return _core.dihedral_magnitudes(_f64(mesh.face_normals, "face_normals", (3,)), _i32(mesh.edge_faces))
+
+
+def crease_cut(mesh, join):
+    """The cut of :func:`igl_hhj.features.cut_along` (reference
+    :func:`igl_hhj.features.cut_along_reference`): ``join`` (#E,) bool, the edges across
+    which corners stay together (two faces, not a crease).  Returns ``(Fc (#F, 3) int64,
+    extra (k,) int64)``: the cut faces and the vertex of every extra side (row #V + i)."""
+    join = np.ascontiguousarray(join, dtype=np.uint8)
+    if join.shape != (mesh.n_edges,):
+        raise ValueError(f"crease_cut: join must have shape ({mesh.n_edges},), got {join.shape}")
+    return _core.crease_cut(_i64(mesh.F), int(mesh.n_vertices), _i32(mesh.edge_faces),
+                            _i8(mesh.edge_local_index), join, _f64(mesh.face_areas, "face_areas"))
 
 
 def transport_phases(mesh, N):

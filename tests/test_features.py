@@ -476,6 +476,7 @@ def test_side_tolerance_in_the_units_of_the_part(monkeypatch):
         calls.append((sub.n_vertices, out[1]))
         return out
     monkeypatch.setattr(kernels, "intrinsic_smoothing", counted)
+    monkeypatch.setattr(kernels, "task_workers", lambda: 1)     # the calls in part order
     own, scaled = X.copy(), X.copy()
     intrinsic.adaptive_smoothing_by_parts(cm, own, *args)
     plain_calls, calls[:] = list(calls), []
@@ -491,3 +492,53 @@ def test_side_tolerance_in_the_units_of_the_part(monkeypatch):
     assert np.abs(scaled - own).max() <= 1e-3 * rms
     with pytest.raises(ValueError, match="scale_groups"):
         intrinsic.adaptive_smoothing_by_parts(cm, X.copy(), *args, scale_groups=np.zeros(3, dtype=int))
+
+
+def _random_creased_meshes():
+    """Meshes whose cut exercises every branch of the numbering: the cube (corners with
+    three sides), the capped cylinder (two sides of equal area on a symmetric rim), a
+    jittered half ellipsoid with user-named creases (open boundary, ties broken by label),
+    and fandisk when present."""
+    yield ("cube", *_cube(), None)
+    V, F, _ = capped_cylinder(2)
+    yield "capped cylinder", V, F, None
+    V, F, _ = half_ellipsoid(2)
+    rng = np.random.default_rng(3)
+    mesh = as_mesh(V, F)
+    inner = np.flatnonzero(mesh.edge_face_count == 2)
+    yield "half ellipsoid", V, F, mesh.edges[rng.choice(inner, 40, replace=False)]
+    if FANDISK.is_file():
+        V, F, _ = _fandisk()
+        yield "fandisk", V, F, None
+
+
+def test_compiled_cut_is_the_reference_cut():
+    """cut_along's kernel (kernels.crease_cut) gives the numpy reference's arrays exactly
+    (cut_along_reference: the corner graph by graph_components, the numbering by lexsort),
+    and the compiled |θ_e| (kernels.dihedral_magnitudes) agree with the numpy reference to
+    one ulp of π, with the same crease edges."""
+    for name, V, F, named in _random_creased_meshes():
+        mesh = as_mesh(V, F)
+        theta = ft._dihedral_magnitudes(mesh)
+        ref = ft.dihedral_magnitudes_reference(mesh)
+        assert np.abs(theta - ref).max() <= 4e-16, name
+        crease = ft.crease_edges(mesh, 40.0, edges=named, theta=theta)
+        np.testing.assert_array_equal(crease, ft.crease_edges(mesh, 40.0, edges=named, theta=ref))
+        assert crease.any(), name
+        a, b = ft.cut_along(mesh, crease), ft.cut_along_reference(mesh, crease)
+        for field in ("V", "F", "parent"):
+            np.testing.assert_array_equal(getattr(a, field), getattr(b, field), err_msg=f"{name} {field}")
+        assert a.F.dtype == b.F.dtype == np.int64 and a.parent.dtype == np.int64
+        assert len(a.V) > mesh.n_vertices, name                # there are extra sides
+
+
+def test_crease_cut_refuses_a_joined_edge_without_two_faces():
+    """The kernel checks its inputs (a joined boundary edge would index face -1)."""
+    from igl_hhj import kernels
+    V, F, _ = half_ellipsoid(1)
+    mesh = as_mesh(V[:, :], F[1:])                             # one face less: an open mesh
+    join = np.ones(mesh.n_edges, dtype=bool)                   # its boundary edges included
+    with pytest.raises(ValueError, match="two faces"):
+        kernels.crease_cut(mesh, join)
+    with pytest.raises(ValueError, match="join"):
+        kernels.crease_cut(mesh, join[:-1])

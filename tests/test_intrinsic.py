@@ -246,3 +246,70 @@ def test_smoothing_by_parts_is_each_parts_own_smoothing():
         intrinsic.adaptive_smoothing(ref, alone, C0[faces], mass[verts], phase[eo[e]], rough[verts], 5, 1e-6)
         np.testing.assert_array_equal(Xp[verts], alone)                    # bit for bit
     assert rel(Xp[offsets[2]:offsets[3]], X1[offsets[2]:offsets[3]]) <= 1e-10   # the small one, in the last call
+
+
+def test_run_tasks_is_the_serial_loop(monkeypatch):
+    """kernels.run_tasks: the results of the serial loop in item order, whatever the number
+    of workers and the start order (largest first); the first item's exception in item
+    order; serial below TASKS_MIN_WORK or with one worker."""
+    import threading
+    seen = []
+
+    def fn(x):
+        seen.append((x, threading.current_thread().name))
+        if x in (3, 5):
+            raise KeyError(x)
+        return x * x
+    monkeypatch.setattr(kernels, "task_workers", lambda: 2)
+    sizes = [kernels.TASKS_MIN_WORK] * 3
+    assert kernels.run_tasks(fn, [0, 1, 2], sizes) == [0, 1, 4]
+    assert {x for x, _ in seen} == {0, 1, 2}
+    seen.clear()
+    assert kernels.run_tasks(fn, [7, 8, 9], [1, 5, kernels.TASKS_MIN_WORK]) == [49, 64, 81]
+    assert seen[0][0] == 9                                  # the largest item starts first
+    with pytest.raises(KeyError, match="3"):
+        kernels.run_tasks(fn, [1, 3, 5, 2], [kernels.TASKS_MIN_WORK] * 4)
+    seen.clear()
+    assert kernels.run_tasks(fn, [1, 2], [1, 1]) == [1, 4]     # too little work: the caller alone
+    assert {t for _, t in seen} == {threading.current_thread().name}
+    monkeypatch.setattr(kernels, "task_workers", lambda: 1)
+    seen.clear()
+    assert kernels.run_tasks(fn, [1, 2], sizes[:2]) == [1, 4]
+    assert {t for _, t in seen} == {threading.current_thread().name}
+
+
+def test_smoothing_by_parts_concurrent_is_serial_bit_for_bit(monkeypatch):
+    """The sides of a cut smoothed on two threads at once (kernels.run_tasks) are the serial
+    loop's values bit for bit: each call runs single-threaded and a kernel's bits do not
+    depend on its thread count."""
+    from igl_hhj import features as ft
+    from igl_hhj.recovery import QUALITY_FLOOR, smoothing_coefficients
+    from igl_hhj.surfaces.creased import capped_cylinder
+    V, F, _ = capped_cylinder(3)
+    mesh = TriangleMesh(V, F)
+    cut, cm = ft._cut_mesh(mesh, ft.crease_edges(mesh))
+    N = cm.vertex_normals
+    w = kernels.recovery_weights(cm, QUALITY_FLOOR)
+    X, rough = kernels.intrinsic_patch_recovery(cm, ft.feature_shape_operator(V, F), N, w)
+    C0, m = smoothing_coefficients(cm, w)
+    args = (C0, m, kernels.transport_phases(cm, N), rough, 5, 1e-6)
+    out = {}
+    threads = []
+    orig = kernels.intrinsic_smoothing
+
+    def spy(*a, **k):
+        import threading
+        threads.append(threading.current_thread().name)
+        return orig(*a, **k)
+    monkeypatch.setattr(kernels, "intrinsic_smoothing", spy)
+    monkeypatch.setattr(kernels, "ADAPT_TO_LOAD", False)
+    for workers in (1, 2):
+        monkeypatch.setattr(kernels, "task_workers", lambda w=workers: w)
+        threads.clear()
+        Y = X.copy()
+        res = intrinsic.adaptive_smoothing_by_parts(cm, Y, *args, scale_groups=np.zeros(len(cut.V), dtype=int))
+        out[workers] = (Y, res)
+        assert len(threads) == 3 and len(set(threads)) == workers
+    np.testing.assert_array_equal(out[1][0], out[2][0])
+    np.testing.assert_array_equal(out[1][1][3], out[2][1][3])
+    assert out[1][1][:3] == out[2][1][:3]

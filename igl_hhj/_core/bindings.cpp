@@ -205,6 +205,41 @@ NB_MODULE(_hhj_core, m) {
         return nb::make_tuple(to_numpy(std::move(s), {(size_t)nV, 3}), to_numpy(std::move(a), {(size_t)nV}));
     });
 
+    m.def("dihedral_magnitudes", [](In<double> N, In<i32> EF) {
+        need(N.ndim() == 2 && N.shape(1) == 3 && EF.ndim() == 2 && EF.shape(1) == 2, "dihedral_magnitudes: shapes");
+        const i64 nE = EF.shape(0), nF = N.shape(0);
+        for (i64 q = 0; q < 2 * nE; ++q) need(EF.data()[q] < nF, "dihedral_magnitudes: edge_faces out of range");
+        std::vector<double> theta(nE);
+        {
+            nb::gil_scoped_release nogil;
+            hhj::ThreadBudget tb(nE, 50000);
+            hhj::dihedral_magnitudes(N.data(), EF.data(), nE, theta.data(), tb.nt);
+        }
+        return to_numpy(std::move(theta), {(size_t)nE});
+    });
+
+    m.def("crease_cut", [](In<i64> F, i64 nV, In<i32> EF, In<i8> ELI, In<std::uint8_t> join, In<double> area) {
+        need(F.ndim() == 2 && F.shape(1) == 3 && EF.ndim() == 2 && EF.shape(1) == 2 && ELI.ndim() == 2 &&
+             ELI.shape(1) == 2, "crease_cut: shapes");
+        const i64 nF = F.shape(0), nE = EF.shape(0);
+        need(ELI.shape(0) == (size_t)nE && join.shape(0) == (size_t)nE && area.shape(0) == (size_t)nF,
+             "crease_cut: join (#E,), area (#F,)");
+        for (i64 q = 0; q < 3 * nF; ++q) need(F.data()[q] >= 0 && F.data()[q] < nV, "crease_cut: F out of range");
+        for (i64 e = 0; e < nE; ++e)
+            if (join.data()[e])
+                for (int s = 0; s < 2; ++s)
+                    need(EF.data()[2 * e + s] >= 0 && EF.data()[2 * e + s] < nF && ELI.data()[2 * e + s] >= 0 &&
+                             ELI.data()[2 * e + s] < 3,
+                         "crease_cut: a joined edge needs two faces");
+        std::vector<i64> Fc((size_t)nF * 3), extra;
+        {
+            nb::gil_scoped_release nogil;
+            hhj::crease_cut(F.data(), nF, nV, EF.data(), ELI.data(), nE, join.data(), area.data(), Fc.data(), extra);
+        }
+        const size_t k = extra.size();
+        return nb::make_tuple(to_numpy(std::move(Fc), {(size_t)nF, 3}), to_numpy(std::move(extra), {k}));
+    });
+
     m.def("edge_morton_order", [](In<double> V, In<i32> E) {
         need(V.ndim() == 2 && V.shape(1) == 3 && E.ndim() == 2 && E.shape(1) == 2, "edge_morton_order: shapes");
         const i64 nE = E.shape(0);

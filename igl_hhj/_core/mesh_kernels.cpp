@@ -2,6 +2,7 @@
 // smaller vertex, then by the larger): unique edges, face->edge, edge->face,
 // incidence counts and half-edge signs, in the conventions of igl_hhj/mesh.py.
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 #include "core.hpp"
@@ -191,6 +192,94 @@ void vertex_area_sums(const i64* F, i64 nF, i64 nV, const double* cross, const d
             for (int k = 0; k < 3; ++k) s[3 * v + k] += cross[3 * f + k];
             a[v] += dbl[f];
         }
+}
+
+// dihedral_magnitudes (features._dihedral_magnitudes): |θ_e| = atan2(|ν_0 × ν_1|, ν_0 · ν_1) of
+// the unit normals N (#F,3) of the two faces EF (#E,2) of every edge with two faces, 0 on the
+// others (EF column 1 = -1); the cross product's components in the order of np.cross.
+void dihedral_magnitudes(const double* N, const i32* EF, i64 nE, double* theta, int nt) {
+#pragma omp parallel for schedule(static) num_threads(nt)
+    for (i64 e = 0; e < nE; ++e) {
+        const i64 f0 = EF[2 * e], f1 = EF[2 * e + 1];
+        if (f0 < 0 || f1 < 0) { theta[e] = 0.0; continue; }
+        const double* a = N + 3 * f0;
+        const double* b = N + 3 * f1;
+        double c = a[1] * b[2] - a[2] * b[1];
+        double s = c * c;
+        c = a[2] * b[0] - a[0] * b[2];
+        s += c * c;
+        c = a[0] * b[1] - a[1] * b[0];
+        s += c * c;
+        theta[e] = std::atan2(std::sqrt(s), a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
+    }
+}
+
+// crease_cut (features.cut_along): the sides of every vertex are the connected components of
+// its corners, corners 3f+c of the two faces of an edge with join[e] != 0 being joined where
+// they hold the same vertex (union-find over the 3#F corners; components labelled in the
+// order of their smallest corner).  A vertex's primary side (largest incident area, ties to
+// the lowest label) keeps its index; its other sides get #V, #V+1, ... in the order (vertex,
+// -area, label).  Writes Fc (#F,3) (the cut faces, F's order and corner order) and appends
+// the vertex of every extra side to `extra` (its row #V + k).
+void crease_cut(const i64* F, i64 nF, i64 nV, const i32* EF, const i8* ELI, i64 nE,
+                const unsigned char* join, const double* face_area, i64* Fc, std::vector<i64>& extra) {
+    const i64 nC = 3 * nF;
+    std::vector<i64> parent(nC);
+    for (i64 q = 0; q < nC; ++q) parent[q] = q;
+    auto find = [&](i64 q) {
+        while (parent[q] != q) { parent[q] = parent[parent[q]]; q = parent[q]; }
+        return q;
+    };
+    auto unite = [&](i64 p, i64 q) {
+        p = find(p);
+        q = find(q);
+        if (p != q) parent[std::max(p, q)] = std::min(p, q);
+    };
+    static const int nxt[3] = {1, 2, 0}, prv[3] = {2, 0, 1};
+    for (i64 e = 0; e < nE; ++e) {
+        if (!join[e]) continue;
+        const i64 f0 = EF[2 * e], f1 = EF[2 * e + 1];
+        const int i0 = ELI[2 * e], i1 = ELI[2 * e + 1];
+        // in f0 the edge runs x_{i0+1} -> x_{i0+2}, in f1 the other way
+        unite(3 * f0 + nxt[i0], 3 * f1 + prv[i1]);
+        unite(3 * f0 + prv[i0], 3 * f1 + nxt[i1]);
+    }
+    std::vector<i64> label(nC), root_label(nC, -1), comp_vertex, count(nV, 0);
+    std::vector<double> area;
+    for (i64 q = 0; q < nC; ++q) {
+        const i64 r = find(q);
+        if (root_label[r] < 0) {
+            root_label[r] = (i64)comp_vertex.size();
+            comp_vertex.push_back(F[q]);
+            area.push_back(0.0);
+            ++count[F[q]];
+        }
+        label[q] = root_label[r];
+        area[label[q]] += face_area[q / 3];      // the sums of np.bincount over the corners
+    }
+    const i64 nS = (i64)comp_vertex.size();
+    std::vector<i64> index(nS);
+    for (i64 c = 0; c < nS; ++c) index[c] = comp_vertex[c];
+    if (nS > nV) {
+        // the sides of the vertices with several, by vertex (counting sort, labels ascending)
+        std::vector<i64> start(nV + 1, 0);
+        for (i64 c = 0; c < nS; ++c)
+            if (count[comp_vertex[c]] > 1) ++start[comp_vertex[c] + 1];
+        for (i64 v = 0; v < nV; ++v) start[v + 1] += start[v];
+        std::vector<i64> sides(start[nV]), fill(start.begin(), start.end() - 1);
+        for (i64 c = 0; c < nS; ++c)
+            if (count[comp_vertex[c]] > 1) sides[fill[comp_vertex[c]]++] = c;
+        for (i64 v = 0; v < nV; ++v) {
+            if (start[v + 1] - start[v] < 2) continue;
+            auto b = sides.begin() + start[v], en = sides.begin() + start[v + 1];
+            std::stable_sort(b, en, [&](i64 x, i64 y) { return area[x] > area[y]; });
+            for (auto it = b + 1; it != en; ++it) {
+                index[*it] = nV + (i64)extra.size();
+                extra.push_back(v);
+            }
+        }
+    }
+    for (i64 q = 0; q < nC; ++q) Fc[q] = index[label[q]];
 }
 
 }  // namespace hhj
