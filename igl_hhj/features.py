@@ -93,11 +93,9 @@ def dihedral_angles(mesh: TriangleMesh) -> NDArray[np.float64]:
     return theta
 
 
-def _dihedral_magnitudes(mesh, reference=False):
-    """``|θ_e|`` of :func:`dihedral_angles` (#E,) (all the crease test needs; compiled,
-    :func:`igl_hhj.kernels.dihedral_magnitudes`, or ``reference``: :func:`dihedral_magnitudes_reference`)."""
-    if reference:
-        return dihedral_magnitudes_reference(mesh)
+def _dihedral_magnitudes(mesh):
+    """``|θ_e|`` of :func:`dihedral_angles` (#E,) (all the crease test needs), compiled:
+    :func:`igl_hhj.kernels.dihedral_magnitudes` (reference :func:`dihedral_magnitudes_reference`)."""
     return kernels.dihedral_magnitudes(mesh)
 
 

@@ -111,10 +111,7 @@ def _machine_busy():
 
 def _threads():
     """Apply the thread policy for the next kernel call (calling thread only)."""
-    n = _USER_THREADS
-    if ADAPT_TO_LOAD and n > 1 and _machine_busy():
-        n = 1
-    _core.set_num_threads(n)
+    _core.set_num_threads(task_workers())
 
 
 # kernel calls that are independent of each other (the sides of a cut mesh) run on this
@@ -127,9 +124,9 @@ TASKS_MIN_WORK = 4000
 
 
 def task_workers() -> int:
-    """How many independent kernel calls may run at once: the thread policy of
-    :func:`_threads` (``OMP_NUM_THREADS`` or :func:`set_num_threads`, one while the machine
-    is busy)."""
+    """The thread policy: the threads of the next kernel call (:func:`_threads`) and how
+    many independent kernel calls may run at once (:func:`run_tasks`): ``OMP_NUM_THREADS``
+    or :func:`set_num_threads`, one while the machine is busy."""
     n = _USER_THREADS
     if ADAPT_TO_LOAD and n > 1 and _machine_busy():
         n = 1
@@ -615,10 +612,11 @@ def graph_components(pairs, n):
 
 
 def dihedral_magnitudes(mesh):
-    """``|θ_e|`` (#E,) of every edge with two faces (0 on the others); reference
+    """``|θ_e|`` (#E,) of every edge with exactly two faces (0 on the others); reference
     :func:`igl_hhj.features.dihedral_magnitudes_reference`."""
     _threads()
-    return _core.dihedral_magnitudes(_f64(mesh.face_normals, "face_normals", (3,)), _i32(mesh.edge_faces))
+    return _core.dihedral_magnitudes(_f64(mesh.face_normals, "face_normals", (3,)), _i32(mesh.edge_faces),
+                                     _i8(mesh.edge_face_count))
 
 
 def crease_cut(mesh, join):

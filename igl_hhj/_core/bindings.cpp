@@ -205,15 +205,16 @@ NB_MODULE(_hhj_core, m) {
         return nb::make_tuple(to_numpy(std::move(s), {(size_t)nV, 3}), to_numpy(std::move(a), {(size_t)nV}));
     });
 
-    m.def("dihedral_magnitudes", [](In<double> N, In<i32> EF) {
-        need(N.ndim() == 2 && N.shape(1) == 3 && EF.ndim() == 2 && EF.shape(1) == 2, "dihedral_magnitudes: shapes");
+    m.def("dihedral_magnitudes", [](In<double> N, In<i32> EF, In<i8> count) {
+        need(N.ndim() == 2 && N.shape(1) == 3 && EF.ndim() == 2 && EF.shape(1) == 2 &&
+             count.shape(0) == EF.shape(0), "dihedral_magnitudes: shapes");
         const i64 nE = EF.shape(0), nF = N.shape(0);
         for (i64 q = 0; q < 2 * nE; ++q) need(EF.data()[q] < nF, "dihedral_magnitudes: edge_faces out of range");
         std::vector<double> theta(nE);
         {
             nb::gil_scoped_release nogil;
             hhj::ThreadBudget tb(nE, 50000);
-            hhj::dihedral_magnitudes(N.data(), EF.data(), nE, theta.data(), tb.nt);
+            hhj::dihedral_magnitudes(N.data(), EF.data(), count.data(), nE, theta.data(), tb.nt);
         }
         return to_numpy(std::move(theta), {(size_t)nE});
     });

@@ -196,7 +196,7 @@ void edge_morton_order(const double* V, i64 nV, const i32* E, i64 nE, i64* perm)
 void face_metrics(const double* V, const i64* F, i64 nF, double* cross, double* dbl, double* l2max, int nt);
 void vertex_area_sums(const i64* F, i64 nF, i64 nV, const double* cross, const double* dbl, double* s,
                       double* a);
-void dihedral_magnitudes(const double* N, const i32* EF, i64 nE, double* theta, int nt);
+void dihedral_magnitudes(const double* N, const i32* EF, const i8* count, i64 nE, double* theta, int nt);
 void crease_cut(const i64* F, i64 nF, i64 nV, const i32* EF, const i8* ELI, i64 nE,
                 const unsigned char* join, const double* face_area, i64* Fc, std::vector<i64>& extra);
 

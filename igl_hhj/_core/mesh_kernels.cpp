@@ -194,14 +194,15 @@ void vertex_area_sums(const i64* F, i64 nF, i64 nV, const double* cross, const d
         }
 }
 
-// dihedral_magnitudes (features._dihedral_magnitudes): |θ_e| = atan2(|ν_0 × ν_1|, ν_0 · ν_1) of
-// the unit normals N (#F,3) of the two faces EF (#E,2) of every edge with two faces, 0 on the
-// others (EF column 1 = -1); the cross product's components in the order of np.cross.
-void dihedral_magnitudes(const double* N, const i32* EF, i64 nE, double* theta, int nt) {
+// dihedral_magnitudes (features.dihedral_magnitudes_reference): |θ_e| = atan2(|ν_0 × ν_1|,
+// ν_0 · ν_1) of the unit normals N (#F,3) of the two faces EF (#E,2) of every edge with
+// exactly two faces (count (#E,) == 2), 0 on the others; the cross product's components in
+// the order of np.cross.
+void dihedral_magnitudes(const double* N, const i32* EF, const i8* count, i64 nE, double* theta, int nt) {
 #pragma omp parallel for schedule(static) num_threads(nt)
     for (i64 e = 0; e < nE; ++e) {
         const i64 f0 = EF[2 * e], f1 = EF[2 * e + 1];
-        if (f0 < 0 || f1 < 0) { theta[e] = 0.0; continue; }
+        if (count[e] != 2 || f0 < 0 || f1 < 0) { theta[e] = 0.0; continue; }
         const double* a = N + 3 * f0;
         const double* b = N + 3 * f1;
         double c = a[1] * b[2] - a[2] * b[1];
