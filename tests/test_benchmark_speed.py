@@ -10,12 +10,24 @@ def test_speed_run_quick():
     assert len(rows) == 3
     for r in rows:
         assert r["libigl"] > 0 and r["dropin"] > 0 and r["S_auto"] > 0 and r["S_cg"] > 0
+        assert r["libigl_r2"] > 0 and r["dropin_r2"] > 0                # radius 2 beside 5
         assert r["chosen"].split()[0] in ("cg", "direct") and r["iterations"] >= 0
         assert r["kb_per_face"] > 0 and r["first_over_later"] > 0 and 0 < r["min_angle"] < 60
         assert len(r["first_over_later_runs"]) == 2       # the median of two fresh processes
         assert r["first_over_later"] == np.median(r["first_over_later_runs"])
     table = speed.markdown(rows)
-    assert table.count("\n") == len(rows) + 1 and "peak KB/face" in table
+    assert table.count("\n") == len(rows) + 1 and "peak KB/face" in table and "ratio r2" in table
+    assert speed.markdown([{k: v for k, v in r.items() if "_r2" not in k} for r in rows]).count("ratio r2") == 0
+
+
+def test_real_meshes_read_off_and_obj_above_a_face_count(tmp_path):
+    import igl
+    from igl_hhj.surfaces import icosphere
+    V, F = icosphere(2)                                   # 320 faces
+    igl.write_triangle_mesh(str(tmp_path / "a.off"), V, F)
+    igl.write_triangle_mesh(str(tmp_path / "b.obj"), *icosphere(1))     # 80 faces
+    assert [m[0] for m in speed._build("real", tmp_path)] == ["a.off", "b.obj"]
+    assert [m[0] for m in speed._build("real", tmp_path, min_faces=100)] == ["a.off"]
 
 
 def test_min_angle_of_equilateral_triangle():

@@ -1,7 +1,8 @@
 """Speed of the drop-in ``igl_hhj.principal_curvature`` against ``igl.principal_curvature``,
 measured in the same run.
 
-    python -m igl_hhj.benchmarks.speed [--quick] [--repeat 3] [--meshes DIR] [--out DIR]
+    python -m igl_hhj.benchmarks.speed [--quick] [--repeat 3] [--meshes DIR] [--out DIR] [--radii 2]
+    python -m igl_hhj.benchmarks.speed --only-real --meshes libigl-tutorial-data --min-faces 5000
     python -m igl_hhj.benchmarks.speed --rtol-study | --sliver-study | --factor-study | --tiny | --features \
         | --profile 'icosphere(8)'
 
@@ -13,7 +14,8 @@ height field (jittered grid with random diagonals cropped to a disc, 5° slivers
 
 For each mesh it prints: the smallest angle; the best-of-``--repeat`` wall time of
 ``igl.principal_curvature`` (default 5-ring quadric fit) and of the drop-in; the ratio
-``t_libigl / t_drop-in`` (> 1: igl_hhj is faster); µs per face; the time of
+``t_libigl / t_drop-in`` (> 1: igl_hhj is faster), also at radius 2 (``--radii``: both
+called with ``radius=r``); µs per face; the time of
 ``igl_hhj.shape_operator`` with ``solver="direct"``, ``"cg"`` and ``"auto"`` (auto must
 never be slower than both); what "auto" chose and its PCG iterations; the peak memory of
 one drop-in call above the input (KB per face, in a fresh subprocess after warm-up calls
@@ -76,8 +78,9 @@ def _ellipsoid(faces):
     return V, F
 
 
-def _build(name, mesh_dir):
-    """[(label, V, F)] for one entry of QUICK / FULL."""
+def _build(name, mesh_dir, min_faces=0):
+    """[(label, V, F)] for one entry of QUICK / FULL ("real": every ``*.off`` and ``*.obj``
+    of ``mesh_dir`` with at least ``min_faces`` faces, e.g. libigl's tutorial data)."""
     import igl
     from ..surfaces import WalkerTorus, icosphere, refine, torus_coarse
     if name.startswith("icosphere("):
@@ -105,9 +108,10 @@ def _build(name, mesh_dir):
         return [(name, V, F)]
     if name == "real":
         out = []
-        for p in sorted(mesh_dir.glob("*.off")):
+        for p in sorted([*mesh_dir.glob("*.off"), *mesh_dir.glob("*.obj")]):
             V, F = igl.read_triangle_mesh(str(p))
-            out.append((p.name, V, F))
+            if len(F) >= min_faces:
+                out.append((p.name, V, F))
         return out
     raise KeyError(name)
 
@@ -197,8 +201,12 @@ def _child_measure(V, F, repeat, fresh=3):
     return out
 
 
-def run(names=FULL, repeat=3, mesh_dir=None, progress=True, memory=True, fresh=3):
+def run(names=FULL, repeat=3, mesh_dir=None, progress=True, memory=True, fresh=3, radii=(2,),
+        min_faces=0):
     """Time libigl and igl_hhj on the named meshes (entries of :data:`FULL` / :data:`QUICK`).
+
+    Both at radius 5 (the defaults: ``libigl``, ``dropin``), and at every radius of
+    ``radii`` (``libigl_r2``, ``dropin_r2``, ...: ``radius=r`` passed to both).
 
     Returns
     -------
@@ -208,9 +216,9 @@ def run(names=FULL, repeat=3, mesh_dir=None, progress=True, memory=True, fresh=3
 
     import igl_hhj
     from igl_hhj.curvature import _shape_operator
-    from igl_hhj.mesh import TriangleMesh
+    from igl_hhj.mesh import MeshDefectError, TriangleMesh
     mesh_dir = _default_mesh_dir() if mesh_dir is None else Path(mesh_dir)
-    meshes = [m for n in names for m in _build(n, mesh_dir)]
+    meshes = [m for n in names for m in _build(n, mesh_dir, min_faces)]
     rows = []
     for label, V, F in progress_bar(meshes, "speed", "mesh", progress):
         nF = len(F)
@@ -218,16 +226,23 @@ def run(names=FULL, repeat=3, mesh_dir=None, progress=True, memory=True, fresh=3
         row = {"mesh": label, "faces": nF, "min_angle": min_angle_degrees(V, F)}
         row["libigl"], _ = _best(lambda: igl.principal_curvature(V, F), rep)
         row["dropin"], _ = _best(lambda: igl_hhj.principal_curvature(V, F), rep)
+        for r in radii:
+            row[f"libigl_r{r}"], _ = _best(lambda: igl.principal_curvature(V, F, r), rep)
+            row[f"dropin_r{r}"], _ = _best(lambda: igl_hhj.principal_curvature(V, F, r), rep)
         for s in ("direct", "cg", "auto"):
             if s == "direct" and nF > DIRECT_MAX_FACES:
                 row["S_direct"] = float("nan")
                 continue
             try:
                 row[f"S_{s}"], _ = _best(lambda: igl_hhj.shape_operator(V, F, solver=s), rep)
-            except igl_hhj.SolverError:
+            except (igl_hhj.SolverError, MeshDefectError):
+                # shape_operator takes manifold meshes only (the drop-in repairs the rest)
                 row[f"S_{s}"] = float("nan")
         info = {}
-        _shape_operator(TriangleMesh(V, F), None, None, None, "auto", info=info)
+        try:
+            _shape_operator(TriangleMesh(V, F), None, None, None, "auto", info=info)
+        except MeshDefectError:
+            info = {"solver": "– (non-manifold: repaired by the drop-in)", "iterations": "–"}
         row["chosen"] = info["solver"] + (" (switched)" if info.get("switched") else "")
         row["iterations"] = info["iterations"]
         row["sliver_dofs"] = info.get("sliver_dofs", 0)
@@ -472,15 +487,24 @@ def profile_stages(V, F, rtol=None, radius=5):
     return out
 
 
+def _radii_of(rows):
+    """The extra radii timed in ``rows`` (keys ``libigl_r<r>``), ascending."""
+    return sorted({int(k[8:]) for r in rows for k in r if k.startswith("libigl_r")})
+
+
 def markdown(rows):
-    head = ["mesh", "faces", "min angle", "libigl (s)", "drop-in (s)", "ratio", "µs/face",
+    radii = _radii_of(rows)
+    head = ["mesh", "faces", "min angle", "libigl (s)", "drop-in (s)", "ratio",
+            *[f"ratio r{r} (libigl / drop-in s)" for r in radii], "µs/face",
             "S_h direct (s)", "S_h cg (s)", "S_h auto (s)", "auto chose", "PCG its",
             "peak KB/face", "1st call / later", "import (s)"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     f3 = lambda x: "–" if not np.isfinite(x) else f"{x:.3f}"  # noqa: E731
     for r in rows:
+        at = [f"**{r[f'libigl_r{q}'] / r[f'dropin_r{q}']:.2f}×** ({f3(r[f'libigl_r{q}'])} / "
+              f"{f3(r[f'dropin_r{q}'])})" if f"libigl_r{q}" in r else "–" for q in radii]
         cells = [r["mesh"], f"{r['faces']:,}", f"{r['min_angle']:.2f}°", f3(r["libigl"]),
-                 f3(r["dropin"]), f"**{r['libigl'] / r['dropin']:.2f}×**",
+                 f3(r["dropin"]), f"**{r['libigl'] / r['dropin']:.2f}×**", *at,
                  f"{1e6 * r['dropin'] / r['faces']:.2f}", f3(r["S_direct"]), f3(r["S_cg"]),
                  f3(r["S_auto"]), r["chosen"], str(r["iterations"]),
                  f"{r['kb_per_face']:.2f}" if "kb_per_face" in r else "–",
@@ -602,6 +626,12 @@ def main(argv=None):
     p.add_argument("--quick", action="store_true", help="three small meshes (seconds)")
     p.add_argument("--repeat", type=int, default=3, help="best of N runs per timing")
     p.add_argument("--meshes", default=None, help="folder of real meshes (default ../shared/data/meshes)")
+    p.add_argument("--min-faces", type=int, default=0,
+                   help="real meshes: only those with at least this many faces (libigl's tutorial "
+                        "data: 5000)")
+    p.add_argument("--radii", type=int, nargs="*", default=[2],
+                   help="radii timed besides 5 (both libigl and the drop-in; default: 2)")
+    p.add_argument("--only-real", action="store_true", help="only the real meshes of --meshes")
     p.add_argument("--no-memory", action="store_true", help="skip the fresh-process columns")
     p.add_argument("--fresh", type=int, default=3,
                    help="fresh processes per mesh for the first-call and import columns (median)")
@@ -653,7 +683,9 @@ def main(argv=None):
         out.mkdir(parents=True, exist_ok=True)
         (out / "speed_rtol.md").write_text(table + "\n")
         return
-    rows = run(QUICK if a.quick else FULL, a.repeat, a.meshes, memory=not a.no_memory, fresh=a.fresh)
+    names = QUICK if a.quick else ("real",) if a.only_real else FULL
+    rows = run(names, a.repeat, a.meshes, memory=not a.no_memory, fresh=a.fresh,
+               radii=tuple(r for r in a.radii if r != 5), min_faces=a.min_faces)
     table = markdown(rows)
     import importlib.metadata
     import platform
