@@ -117,12 +117,36 @@ def _same_cycle(A, B):
     return out
 
 
-def _inconsistent_faces(F):
-    """(#F,) bool: faces on an edge with exactly two faces that traverse it in the same direction."""
+def _row_keys(A, n):
+    """(m,) int64 keys of the rows of A (m, k), entries in [0, n), ordered as the rows are
+    lexicographically (``Σ_j A[:, j] n^(k-1-j)``), or None when n^k would overflow int64:
+    ``np.unique`` of the keys is the row-``np.unique`` (``axis=0``) without its structured
+    sort (armadillo's 86k faces: 50 ms → 10 ms)."""
+    k = A.shape[1]
+    if n ** k >= 2 ** 62:
+        return None
+    key = np.zeros(len(A), dtype=np.int64)
+    for j in range(k):
+        key = key * n + A[:, j]
+    return key
+
+
+def _unique_rows(A, n, **kwargs):
+    """``np.unique(A, axis=0, **kwargs)`` without the unique rows themselves (the index,
+    inverse and count arrays asked for, in that order), through :func:`_row_keys`."""
+    key = _row_keys(A, n)
+    out = np.unique(A if key is None else key, axis=0 if key is None else None, **kwargs)
+    return out[1:]
+
+
+def _inconsistent_faces(F, n=None):
+    """(#F,) bool: faces on an edge with exactly two faces that traverse it in the same direction
+    (``n``: a bound on the vertex indices, default ``F.max() + 1``)."""
     nF = len(F)
+    n = int(F.max()) + 1 if n is None else n
     he = np.concatenate([F[:, [1, 2]], F[:, [2, 0]], F[:, [0, 1]]])       # half-edges, corner-major
     key = np.sort(he, axis=1)
-    _, inv, cnt = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    inv, cnt = _unique_rows(key, n, return_inverse=True, return_counts=True)
     inv = inv.ravel()
     pos = np.bincount(inv, weights=he[:, 0] < he[:, 1], minlength=len(cnt))
     bad_edge = (cnt == 2) & (pos != 1)
@@ -180,7 +204,7 @@ def repair_mesh(V: Any, F: Any) -> RepairedMesh:
     # 3. duplicates (any vertex order): keep the first of each set
     idx = np.flatnonzero(keep)
     if len(idx):
-        _, first = np.unique(np.sort(F[idx], axis=1), axis=0, return_index=True)
+        first, = _unique_rows(np.sort(F[idx], axis=1), nV, return_index=True)
         dup = np.ones(len(idx), dtype=bool)
         dup[first] = False
         summary["duplicate"] = int(dup.sum())
@@ -190,24 +214,30 @@ def repair_mesh(V: Any, F: Any) -> RepairedMesh:
         return RepairedMesh(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64),
                             np.zeros(0, dtype=np.int64), idx, nV, nF, summary)
 
-    # 4. orientation per patch (edges with two faces), majority of the caller's orientation
+    # 4. orientation per patch (edges with two faces), majority of the caller's orientation.
+    # Where every such edge is already traversed both ways, bfs_orient would return the faces
+    # as they are (it flips a face only against a neighbour): skip it (armadillo with one
+    # non-manifold face: 0.11 s; a voxel soup of 85k patches: 1 s)
     Fk = F[idx]
-    O, C = igl.bfs_orient(Fk)
-    O = np.asarray(O, dtype=np.int64)
-    C = np.asarray(C, dtype=np.int64).ravel()
-    nC = int(C.max()) + 1
-    flipped = ~_same_cycle(O, Fk)
-    w = dbl[idx]
-    flip_area = np.bincount(C, weights=w * flipped, minlength=nC)
-    total = np.bincount(C, weights=w, minlength=nC)
-    back = flip_area > 0.5 * total                      # the caller's majority says the other way
-    O[back[C]] = O[back[C]][:, ::-1]
-    bad_comp = np.zeros(nC, dtype=bool)
-    bad_comp[C[_inconsistent_faces(O)]] = True          # bfs_orient could not make it consistent
-    good = ~bad_comp[C]
-    summary["non-orientable"] = int((~good).sum())
-    summary["flipped"] = int((~_same_cycle(O, Fk) & good).sum())
-    O, idx = O[good], idx[good]
+    if not _inconsistent_faces(Fk, nV).any():
+        O = Fk.copy()
+    else:
+        O, C = igl.bfs_orient(Fk)
+        O = np.asarray(O, dtype=np.int64)
+        C = np.asarray(C, dtype=np.int64).ravel()
+        nC = int(C.max()) + 1
+        flipped = ~_same_cycle(O, Fk)
+        w = dbl[idx]
+        flip_area = np.bincount(C, weights=w * flipped, minlength=nC)
+        total = np.bincount(C, weights=w, minlength=nC)
+        back = flip_area > 0.5 * total                  # the caller's majority says the other way
+        O[back[C]] = O[back[C]][:, ::-1]
+        bad_comp = np.zeros(nC, dtype=bool)
+        bad_comp[C[_inconsistent_faces(O, nV)]] = True  # bfs_orient could not make it consistent
+        good = ~bad_comp[C]
+        summary["non-orientable"] = int((~good).sum())
+        summary["flipped"] = int((~_same_cycle(O, Fk) & good).sum())
+        O, idx = O[good], idx[good]
     if len(idx) == 0:
         return RepairedMesh(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64),
                             np.zeros(0, dtype=np.int64), idx, nV, nF, summary)

@@ -339,3 +339,35 @@ def test_real_mesh_with_duplicates_and_flips():
     one_warning(ws, "duplicate", "re-oriented")
     check_structure(out, len(V))
     np.testing.assert_allclose(out[2], clean_out[2], atol=1e-8, equal_nan=True)
+
+
+# --------------------------------------------------------------------------- repair's own cost
+def test_unique_rows_is_numpys_row_unique():
+    """The integer-key row unique of the repair gives np.unique(axis=0)'s index, inverse and
+    counts, also through its fallback (indices too large for one int64 key)."""
+    rng = np.random.default_rng(3)
+    for n, k in ((50, 2), (50, 3), (2 ** 40, 2), (2 ** 30, 3)):
+        A = rng.integers(0, min(n, 40), size=(500, k))
+        A[::7] += n - min(n, 40)                       # the largest indices too
+        want = np.unique(A, axis=0, return_index=True, return_inverse=True, return_counts=True)[1:]
+        got = rp._unique_rows(A, n, return_index=True, return_inverse=True, return_counts=True)
+        for w, g in zip(want, got):
+            assert np.array_equal(np.ravel(w), np.ravel(g))
+    assert rp._row_keys(np.zeros((1, 3), dtype=np.int64), 2 ** 30) is None
+
+
+def test_consistently_oriented_non_manifold_mesh_skips_bfs_orient_with_its_result():
+    """The repair calls igl.bfs_orient only where an edge of two faces is traversed twice in the
+    same direction: elsewhere bfs_orient returns the faces unchanged (checked here), so
+    skipping it changes nothing; a flipped face still goes through it."""
+    fan = np.array([[F2[0, 0], F2[0, 1], len(V2)]])        # a third face on edge (F[0,0], F[0,1])
+    V = np.vstack([V2, V2[F2[0]].mean(axis=0) + 0.3])
+    F = np.vstack([F2, fan])
+    assert not rp._inconsistent_faces(F).any()
+    assert np.array_equal(np.asarray(igl.bfs_orient(F)[0]), F)
+    R = rp.repair_mesh(V, F)
+    assert R.summary["non-manifold"] > 0 and R.summary["flipped"] == 0
+    Ff = F.copy()
+    Ff[5] = Ff[5, ::-1]
+    assert rp._inconsistent_faces(Ff).any()
+    assert rp.repair_mesh(V, Ff).summary["flipped"] == 1
