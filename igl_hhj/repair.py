@@ -141,16 +141,15 @@ def _unique_rows(A, n, **kwargs):
 
 def _inconsistent_faces(F, n=None):
     """(#F,) bool: faces on an edge with exactly two faces that traverse it in the same direction
-    (``n``: a bound on the vertex indices, default ``F.max() + 1``)."""
-    nF = len(F)
+    (``n``: a bound on the vertex indices, default ``F.max() + 1``).  The edge maps are the
+    compiled :func:`igl_hhj.kernels.topology` pass, the test that of
+    :class:`igl_hhj.mesh.TriangleMesh` (no face may repeat a corner here)."""
+    from . import kernels
     n = int(F.max()) + 1 if n is None else n
-    he = np.concatenate([F[:, [1, 2]], F[:, [2, 0]], F[:, [0, 1]]])       # half-edges, corner-major
-    key = np.sort(he, axis=1)
-    inv, cnt = _unique_rows(key, n, return_inverse=True, return_counts=True)
-    inv = inv.ravel()
-    pos = np.bincount(inv, weights=he[:, 0] < he[:, 1], minlength=len(cnt))
-    bad_edge = (cnt == 2) & (pos != 1)
-    return bad_edge[inv].reshape(3, nF).any(axis=0)
+    _, face_edges, count, _, _, sign = kernels.topology(F, n)
+    pos = np.bincount(face_edges.ravel(), weights=sign.ravel() > 0, minlength=len(count))
+    bad_edge = (count == 2) & (pos != 1)
+    return bad_edge[face_edges].any(axis=1)
 
 
 def repair_mesh(V: Any, F: Any) -> RepairedMesh:

@@ -371,3 +371,23 @@ def test_consistently_oriented_non_manifold_mesh_skips_bfs_orient_with_its_resul
     Ff[5] = Ff[5, ::-1]
     assert rp._inconsistent_faces(Ff).any()
     assert rp.repair_mesh(V, Ff).summary["flipped"] == 1
+
+
+def test_inconsistent_faces_from_the_compiled_edge_maps_match_the_numpy_form():
+    """_inconsistent_faces reads kernels.topology's edge maps; on random triangle soups (non-manifold
+    edges, both directions) it flags exactly the faces the half-edge np.unique form flags."""
+    def numpy_form(F):
+        he = np.concatenate([F[:, [1, 2]], F[:, [2, 0]], F[:, [0, 1]]])
+        _, inv, cnt = np.unique(np.sort(he, axis=1), axis=0, return_inverse=True, return_counts=True)
+        inv = inv.ravel()
+        pos = np.bincount(inv, weights=he[:, 0] < he[:, 1], minlength=len(cnt))
+        return ((cnt == 2) & (pos != 1))[inv].reshape(3, len(F)).any(axis=0)
+    rng = np.random.default_rng(5)
+    flagged = 0
+    for _ in range(100):
+        n = int(rng.integers(4, 30))
+        F = np.array([rng.choice(n, 3, replace=False) for _ in range(int(rng.integers(1, 60)))])
+        want = numpy_form(F)
+        assert np.array_equal(rp._inconsistent_faces(F), want)
+        flagged += int(want.any())
+    assert flagged > 10                                   # the soups do exercise the test
