@@ -19,6 +19,7 @@ import warnings
 
 import numpy as np
 
+from .constants import AUTO_DIRECT_MAX
 from .mesh import TriangleMesh
 
 __all__ = ["solve_groups", "submesh", "split_parts"]
@@ -35,7 +36,6 @@ def solve_groups(mesh: TriangleMesh, solver):
     if solver == "direct" or mesh.n_faces == 0:
         return None
     from . import kernels
-    from .solvers import AUTO_DIRECT_MAX
     labels, n = kernels.vertex_components(mesh)
     if n <= 1:
         return None

@@ -27,6 +27,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from .constants import SPD_AUTO_CG_MAXITER, SPD_AUTO_DIRECT_MAX
 from .errors import SolverDidNotConverge
 from .mesh import TriangleMesh
 
@@ -37,11 +38,6 @@ __all__ = [
 ]
 
 
-# solver="auto" factorises directly up to this many unknowns, above it uses PCG.
-AUTO_DIRECT_MAX = 50000
-# ... and gives PCG this many iterations before falling back to the direct solver
-# (well-shaped meshes need 50–250; meshes full of slivers can need thousands).
-AUTO_CG_MAXITER = 600
 
 
 def _sym_outer(u, v):
@@ -266,10 +262,10 @@ def solve_spd(A, R, *, method="auto", rtol=1e-10, maxiter=None, preconditioner=N
         "direct": one sparse factorisation (:func:`igl_hhj.solvers.cholesky_solve`:
         QDLDL up to 200k unknowns, CHOLMOD via cholespy above, pivoted SuperLU when the
         residual check fails).
-        "auto": direct up to ``AUTO_DIRECT_MAX`` (50 000) unknowns; above,
+        "auto": direct up to ``SPD_AUTO_DIRECT_MAX`` (50 000) unknowns; above,
         PCG, switching to the direct solver as soon as the measured
         convergence rate predicts more than ``maxiter`` (default
-        ``AUTO_CG_MAXITER`` = 600) further iterations (checked every 20 iterations).
+        ``SPD_AUTO_CG_MAXITER`` = 600) further iterations (checked every 20 iterations).
     rtol : float
         CG stops when ``‖r_j‖ ≤ rtol ‖R_j‖`` for every column j.  The default
         1e-10 leaves a solver error far below every discretisation error in
@@ -293,11 +289,11 @@ def solve_spd(A, R, *, method="auto", rtol=1e-10, maxiter=None, preconditioner=N
     n = A.shape[0]
     if method not in ("auto", "cg", "direct"):
         raise ValueError(f"unknown solver method {method!r}; use 'auto', 'cg' or 'direct'")
-    if method == "auto" and n <= AUTO_DIRECT_MAX:
+    if method == "auto" and n <= SPD_AUTO_DIRECT_MAX:
         method = "direct"
     X = None
     if maxiter is None:
-        maxiter = AUTO_CG_MAXITER if method == "auto" else 2000
+        maxiter = SPD_AUTO_CG_MAXITER if method == "auto" else 2000
     if method in ("cg", "auto") and n > 0:
         if preconditioner is not None and not sp.issparse(preconditioner):
             try:
@@ -462,7 +458,7 @@ class HHJProjection:
         else:
             rhs_f = rhs
         M = None
-        if self.solver == "cg" or (self.solver == "auto" and self._A_ff.shape[0] > AUTO_DIRECT_MAX):
+        if self.solver == "cg" or (self.solver == "auto" and self._A_ff.shape[0] > SPD_AUTO_DIRECT_MAX):
             M = face_schwarz_preconditioner(self.mesh, self.A, self.phi,
                                             self.free if self.fixed.any() else None)
         s[self.free] = solve_spd(self._A_ff, rhs_f, method=self.solver, preconditioner=M)

@@ -50,6 +50,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from .constants import (ADAPTIVE_GAIN, ADAPTIVE_POWER, ADAPTIVE_RANGE, PILOT_RADIUS,
+                        SMOOTHING_MAXITER, SMOOTHING_ORDER, SMOOTHING_STEPS, SPLIT_MIN_VERTICES)
 from .mesh import TriangleMesh
 
 __all__ = [
@@ -58,21 +60,6 @@ __all__ = [
     "vertex_stage", "vertex_stage_reference", "adaptive_smoothing", "adaptive_smoothing_by_parts", "smoothing_rtol", "roughness", "adaptive_radius", "transport_phase_components", "SMOOTHING_STEPS", "SMOOTHING_ORDER",
 ]
 
-SMOOTHING_STEPS = 2
-SMOOTHING_ORDER = 2
-ADAPTIVE_GAIN = 0.3
-"""Gain of :func:`adaptive_radius` (r = radius · 0.3 ρ^{1/4} / (κh), fitted)."""
-ADAPTIVE_POWER = 0.25
-ADAPTIVE_RANGE = (0.2, 5.0)
-"""Bounds of the factor ``a`` of :func:`adaptive_radius` (radius 5: 1 to 25 rings)."""
-SMOOTHING_MAXITER = 500
-"""Iteration cap of each smoothing solve of :func:`vertex_stage` (a solve that reaches it
-sends the vertex stage to the direct reference)."""
-PILOT_RADIUS = 5
-"""Radius of the pilot smoothing (one implicit step) whose curvature sets the scale."""
-SPLIT_MIN_VERTICES = 64
-""":func:`adaptive_smoothing_by_parts`: components with fewer vertices are smoothed
-together in one call (a call's fixed cost would outweigh their iterations)."""
 
 
 def vertex_frames(N):

@@ -58,23 +58,11 @@ import warnings
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .constants import COORDINATE_MAX, DEGENERATE_AREA_RTOL, FOLDED_NORMAL_RTOL, MIN_MESH_SIZE
+
 __all__ = ["TriangleMesh", "validate_mesh", "as_mesh", "mark_bad_vertices", "MeshWarning", "MeshDefectError",
            "DEGENERATE_AREA_RTOL", "COORDINATE_MAX", "MIN_MESH_SIZE", "topology_reference"]
 
-DEGENERATE_AREA_RTOL = 1e-7
-"""A face with ``2|T| ≤ DEGENERATE_AREA_RTOL × (longest edge)²`` (smallest angle
-below ~1e-7 rad) is rejected: libigl's edge-length formulas lose all accuracy
-about a decade below (module docstring)."""
-
-COORDINATE_MAX = 1e75
-"""Largest accepted ``|coordinate|`` (squared areas overflow float64 beyond ~1e77)."""
-
-MIN_MESH_SIZE = 1e-60
-"""Smallest accepted longest edge (squared areas underflow towards subnormals below)."""
-
-FOLDED_NORMAL_RTOL = float(np.sqrt(np.finfo(np.float64).eps))
-"""A vertex has no tangent plane when ``|Σ_T |T| ν_T| ≤ FOLDED_NORMAL_RTOL Σ_T |T|``
-(the normalised direction would carry less than half the digits of float64)."""
 
 
 class MeshWarning(UserWarning):

@@ -31,6 +31,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from .constants import (BOUNDARY_BAND_RINGS, BOUNDARY_LENGTH_FACTOR, QUALITY_FLOOR,
+                        SMOOTHING_ORDER, SMOOTHING_PER_RADIUS, SMOOTHING_STEPS)
 from .mesh import TriangleMesh
 
 __all__ = [
@@ -38,19 +40,6 @@ __all__ = [
     "smoothing_length", "smoothing_matrices", "smoothing_coefficients", "recover_and_smooth", "patch_recover", "smooth_recovered", "boundary_band", "BOUNDARY_LENGTH_FACTOR", "SMOOTHING_PER_RADIUS", "SMOOTHING_STEPS", "SMOOTHING_ORDER", "tangent_projection",
 ]
 
-# Smoothing length ℓ = SMOOTHING_PER_RADIUS · radius · h̄ (h̄ = mean edge length).
-# Measured by ``python -m igl_hhj.benchmarks.robustness --sweep`` (error vs radius on
-# clean, jittered and noisy meshes).
-SMOOTHING_PER_RADIUS = 0.2
-# Near an open boundary (faces touching the 2-ring band) the smoothing length is this
-# many times longer: the diffusion sees half a neighbourhood there (natural boundary
-# condition), so with the same ℓ the boundary band keeps twice the noise.
-BOUNDARY_LENGTH_FACTOR = 2.0
-BOUNDARY_BAND_RINGS = 2
-# implicit steps per application of the diffusion (see smooth_vertex_tensors)
-SMOOTHING_STEPS = 2
-# bias-reduction order of the kernel: 1 plain diffusion G, 2 twicing 2G - G², 3: 3G - 3G² + G³
-SMOOTHING_ORDER = 2
 
 _SYM = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
 
@@ -61,10 +50,6 @@ def face_quality(mesh: TriangleMesh):
     with np.errstate(invalid="ignore", divide="ignore"):
         q = 4.0 * np.sqrt(3.0) * mesh.face_areas / l2
     return np.where(np.isfinite(q), q, 0.0)
-
-
-# Faces whose (neighbourhood) quality is below this get a weight that falls off linearly.
-QUALITY_FLOOR = 0.1
 
 
 def recovery_weights(mesh: TriangleMesh):

@@ -32,7 +32,7 @@ import numpy as np
 
 __all__ = ["try_dropin", "MAX_EDGES"]
 
-from .solvers import ENVELOPE_MAX as MAX_EDGES
+from .constants import ENVELOPE_MAX as MAX_EDGES
 
 _PARAMS = None
 
@@ -44,11 +44,10 @@ def _params():
         import igl
 
         from . import intrinsic as it
-        from .boundary_estimation import FIT_RINGS, SIDE_DOT_MIN
-        from .mesh import COORDINATE_MAX, DEGENERATE_AREA_RTOL, FOLDED_NORMAL_RTOL, MIN_MESH_SIZE
-        from .recovery import (BOUNDARY_BAND_RINGS, BOUNDARY_LENGTH_FACTOR, QUALITY_FLOOR,
-                               SMOOTHING_PER_RADIUS, _kernel_coefficients)
-        from .solvers import DIRECT_RESIDUAL_RTOL
+        from .constants import (BOUNDARY_BAND_RINGS, BOUNDARY_LENGTH_FACTOR, COORDINATE_MAX,
+                                DEGENERATE_AREA_RTOL, DIRECT_RESIDUAL_RTOL, FIT_RINGS, FOLDED_NORMAL_RTOL,
+                                MIN_MESH_SIZE, QUALITY_FLOOR, SIDE_DOT_MIN, SMOOTHING_PER_RADIUS)
+        from .recovery import _kernel_coefficients
         head = (DEGENERATE_AREA_RTOL, MIN_MESH_SIZE, FOLDED_NORMAL_RTOL, QUALITY_FLOOR,
                 DIRECT_RESIDUAL_RTOL, MAX_EDGES)
         tail = (int(FIT_RINGS), float(SIDE_DOT_MIN), int(BOUNDARY_BAND_RINGS), float(BOUNDARY_LENGTH_FACTOR))

@@ -46,30 +46,14 @@ except ImportError:  # pragma: no cover - qdldl is a dependency
     _qdldl = None
 
 from . import kernels
+# the strategy's constants (values and the measurements behind them: igl_hhj.constants), as
+# globals of this module: a study may set e.g. ``solvers.SLIVER_ANGLE`` for the solver alone
+from .constants import (AUTO_DIRECT_MAX, CG_MAXITER, DEFAULT_RTOL, DIRECT_MAX, DIRECT_RESIDUAL_RTOL,
+                        ENVELOPE_MAX, LDL_MAX, PROBE_ITER, SLIVER_ANGLE, SLIVER_MAX_FRACTION)
 from .errors import SolverDidNotConverge, SolverError
 
 __all__ = ["DEFAULT_RTOL", "HHJSystem", "cholesky_solve", "mass_solver", "pcg", "SolveInfo"]
 
-DEFAULT_RTOL = 1e-6
-# "auto": factorise without trying PCG up to this many unknowns (everything is instant there)
-AUTO_DIRECT_MAX = 3_000
-# "auto": never factorise above this many unknowns (fill and memory), PCG runs to convergence
-DIRECT_MAX = 700_000
-# "auto": PCG checks its rate this often
-PROBE_ITER = 20
-# iteration cap of "cg"
-CG_MAXITER = 5000
-# faces with a smallest angle below this (degrees) form the sliver subdomain of the
-# two-level preconditioner (exact sparse solve on their DOFs); chosen by
-# `python -m igl_hhj.benchmarks.speed --sliver-study` (0°-25° on camelhead, the bunny
-# upsampled twice, an open scan and a jittered ellipsoid: 15-20° was fastest on all four;
-# re-measured with the QDLDL sliver solve inside the PCG, 15°-30°: 20° is fastest or
-# within 8 % of 25° on all four, 30° up to 1.6x slower)
-SLIVER_ANGLE = 20.0
-# above this fraction of sliver DOFs "auto" factorises A itself: the two-level's subdomain
-# factorisation then costs a good part of the full one, with the PCG on top (open scan,
-# 52 % sliver DOFs: S_h direct 0.12 s, two-level PCG 0.15 s in `speed`; camelhead, 26 %: 0.06 / 0.06 s)
-SLIVER_MAX_FRACTION = 0.4
 
 
 class SolveInfo(dict):
@@ -93,15 +77,6 @@ def _pcg_iter_seconds(n, k):
     (Walker's sliver torus), 2 threads (``--sliver-study``; the two-level adds
     ``2|S|/n`` of this, see :meth:`HHJSystem._pcg`)."""
     return 0.6e-8 * n * (1 + k)
-
-
-# Up to this many unknowns the direct solver is QDLDL (AMD ordering + simplicial LDLᵀ, the
-# ``qdldl`` wheel); above, CHOLMOD's supernodal Cholesky (cholespy, whose bundled reference
-# BLAS makes its supernodal kernels slow on small and medium matrices).  Measured on the
-# HHJ matrices (python -m igl_hhj.benchmarks.speed --factor-study): QDLDL factorises 10k–167k
-# unknowns 1.6–3.4x faster than CHOLMOD and 1.6–4x faster than SuperLU-MMD; CHOLMOD wins
-# at 393k (2.8 s against 4.0 s).  QDLDL's solves are 2–3x slower than CHOLMOD's.
-LDL_MAX = 200_000
 
 
 def _splu(A):
@@ -194,17 +169,6 @@ def factorize(A, *, prefer_lu=False):
         if fn is not None:
             return fn
     return _splu(A)
-
-
-# Direct solves up to this many unknowns run the compiled dense envelope LDLᵀ
-# (:func:`igl_hhj.kernels.envelope_ldl_solve`) on the fixed-width rows, without scipy
-# sparse matrices or a QDLDL factor object: on tiny meshes their construction cost
-# 10-20x the factorisation (a 12-face cube: 0.25 ms of a 0.57 ms drop-in call).
-ENVELOPE_MAX = 700
-
-# A direct solve without pivoting is accepted when ‖A X - R‖ ≤ this × ‖R‖ per column;
-# otherwise (tiny pivots of a numerically semi-definite A) pivoted LU solves again.
-DIRECT_RESIDUAL_RTOL = 1e-8
 
 
 def cholesky_solve(A, R):
