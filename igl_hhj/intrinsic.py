@@ -402,7 +402,7 @@ def adaptive_smoothing_by_parts(mesh: TriangleMesh, X, C0, mass, phase, rough, r
     Returns ``(status, iterations, components, radius (#F,))`` as :func:`adaptive_smoothing`
     (iterations: the largest of a call's; status: the first failed call's, X then unchanged).
     """
-    from . import kernels
+    from . import kernels, runtime
     from .components import split_parts
     labels, n = kernels.vertex_components(mesh)
     size = np.bincount(labels, minlength=n)
@@ -437,9 +437,9 @@ def adaptive_smoothing_by_parts(mesh: TriangleMesh, X, C0, mass, phase, rough, r
         return adaptive_smoothing(sub, Xp[v], C0p[f], mp[v], php[e], rp[v], radius, rtol, maxiter,
                                   solve_rtol=tol[c])
 
-    # the parts are independent: on several threads at once (kernels.run_tasks; the same bits)
+    # the parts are independent: on several threads at once (runtime.run_tasks; the same bits)
     its = 0
-    results = kernels.run_tasks(solve, range(len(parts)), [p[0].n_vertices for p in parts])
+    results = runtime.run_tasks(solve, range(len(parts)), [p[0].n_vertices for p in parts])
     for (status, k, _, rf), (_, _, f, _) in zip(results, parts):
         if status != 0:
             return status, its, n, r

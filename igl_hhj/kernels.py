@@ -1,45 +1,29 @@
 """Thin Python face of the compiled core ``igl_hhj._hhj_core`` (C++17, nanobind).
 
-This is the only module that imports the extension.  Every function checks and
-coerces its arrays once (C-contiguous float64 / int64, shapes; the topology maps of
-:class:`igl_hhj.mesh.TriangleMesh` as they are stored, int32 indices and int8 local
-indices, so no call copies them) and hands them to one C++ kernel; the kernels have no hidden state and release the GIL.  The
-readable numpy reference of each kernel is named in its docstring; tests
-(``tests/core/test_core.py``) compare the two.
+Every function checks and coerces its arrays once (C-contiguous float64 / int64, shapes;
+the topology maps of :class:`igl_hhj.mesh.TriangleMesh` as they are stored, int32 indices
+and int8 local indices, so no call copies them) and hands them to one C++ kernel; the
+kernels have no hidden state and release the GIL.  The readable numpy reference of each
+kernel is named in its docstring; tests (``tests/core/``, ``tests/mesh/``, ``tests/hhj/``,
+``tests/vertex_stage/``) compare the two.
 
-Threads: a kernel uses all OpenMP threads (``OMP_NUM_THREADS``) when it is the
-only igl_hhj kernel running, and one thread when called while another one runs
-(several Python threads), so concurrent callers never oversubscribe the cores.
-Reductions use a fixed chunking, so results are bit-identical for any thread
-count.
+The extension is loaded, and its thread and heap policy kept, by :mod:`igl_hhj.runtime`:
+every wrapper applies the thread policy (:func:`igl_hhj.runtime.apply_thread_policy`)
+before its call.  The runtime's functions and its documented switches are also reachable
+here under their old names (``kernels.set_num_threads``, ``kernels.run_tasks``,
+``kernels.ADAPT_TO_LOAD = False``, ``kernels.LARGE_CALL_HEAP = False``, ...): reading or
+setting a switch here reads or sets :mod:`igl_hhj.runtime`'s.
 """
 from __future__ import annotations
 
-import functools
-import os
-import threading
-import time
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
-from typing import Any, ParamSpec, TypeVar
+import sys
+import types
 
 import numpy as np
 
-# Idle OpenMP threads sleep instead of spinning (libgomp reads this when the extension
-# loads it).  Measured on the shared 2-core machine (load 8): with the default spinning,
-# two threads made the drop-in 1.8x slower than one; passive waiting made them equal.
-os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
-
-try:
-    from . import _hhj_core
-except ImportError as exc:  # pragma: no cover - exercised only on a broken install
-    raise ImportError(
-        "igl_hhj's compiled core (igl_hhj._hhj_core) is missing or failed to load "
-        f"({exc}). It is built when igl_hhj is installed: reinstall on a machine with a "
-        "C++17 compiler and cmake, e.g. `pip install --force-reinstall --no-cache-dir .` "
-        "from the igl_hhj source tree (scikit-build-core and nanobind come from PyPI)."
-    ) from exc
-_core: Any = _hhj_core      # the extension has no stubs: its functions are typed here, by the wrappers
+from . import runtime
+from .runtime import (apply_thread_policy as _threads, core as _core, large_call_heap,  # noqa: F401
+                      max_threads, run_tasks, set_num_threads, task_workers, with_large_call_heap)
 
 __all__ = [
     "topology", "hhj_system", "jump_apply", "block_pcg", "shape_operator_faces",
@@ -48,7 +32,7 @@ __all__ = [
     "tangent_projection6", "smooth_vertex_tensors", "face_metrics", "vertex_area_sums",
     "intrinsic_patch_recovery", "vertex_components", "transport_phases",
     "adaptive_radius", "principal_hz", "intrinsic_smoothing", "dihedral_magnitudes", "crease_cut",
-    "run_tasks", "task_workers",
+    "run_tasks", "task_workers", "dropin_small",
     "large_call_heap", "with_large_call_heap", "LARGE_CALL_HEAP",
 ]
 
@@ -72,185 +56,21 @@ def _i8(a):
     return np.ascontiguousarray(a, dtype=np.int8)
 
 
-_USER_THREADS = _core.max_threads()     # OMP_NUM_THREADS or the core count
-# Run single-threaded while the machine is already busy (1-minute load average ≥ the
-# number of cores): extra threads then only queue behind other processes.  Results do
-# not depend on the thread count (fixed-chunk reductions).
-ADAPT_TO_LOAD = True
+def _switch(name):
+    """A property of this module that reads and sets :mod:`igl_hhj.runtime`'s ``name``."""
+    return property(lambda self: getattr(runtime, name), lambda self, value: setattr(runtime, name, value),
+                     doc=f"igl_hhj.runtime.{name}")
 
 
-def max_threads():
-    """Number of OpenMP threads a kernel may use (1 without OpenMP)."""
-    return _core.max_threads()
+class _Kernels(types.ModuleType):
+    """This module's type: its runtime switches are :mod:`igl_hhj.runtime`'s."""
+
+    ADAPT_TO_LOAD = _switch("ADAPT_TO_LOAD")
+    LARGE_CALL_HEAP = _switch("LARGE_CALL_HEAP")
+    TASKS_MIN_WORK = _switch("TASKS_MIN_WORK")
 
 
-def set_num_threads(n):
-    """Set the OpenMP thread count of igl_hhj's kernels (``omp_set_num_threads``)."""
-    global _USER_THREADS
-    _USER_THREADS = max(1, int(n))
-    _core.set_num_threads(_USER_THREADS)
-
-
-_CPU_COUNT = os.cpu_count() or 1
-# the load average changes on a scale of seconds: read at most this often (a drop-in call
-# on a tiny mesh makes ~10 kernel calls; reading it each time cost 8 % of a 12-face call)
-_LOAD_TTL = 0.25
-_load_cache = [-1.0, False]          # [monotonic time of the reading, busy]
-
-
-def _machine_busy():
-    now = time.monotonic()
-    if now - _load_cache[0] > _LOAD_TTL:
-        try:
-            busy = os.getloadavg()[0] >= _CPU_COUNT
-        except OSError:  # pragma: no cover - no load average on this platform
-            busy = False
-        _load_cache[0], _load_cache[1] = now, busy
-    return _load_cache[1]
-
-
-def _threads():
-    """Apply the thread policy for the next kernel call (calling thread only)."""
-    _core.set_num_threads(task_workers())
-
-
-# kernel calls that are independent of each other (the sides of a cut mesh) run on this
-# many Python threads at most; each call then runs single-threaded (ThreadBudget: a kernel
-# started while another one runs gets one thread), so the cores are never oversubscribed
-_TASK_POOL: list[Any] = []
-# a task pool pays only from this much work in all (vertices): below it the calls take
-# less than the threads' hand-over costs (~50 µs a task)
-TASKS_MIN_WORK = 4000
-
-
-def task_workers() -> int:
-    """The thread policy: the threads of the next kernel call (:func:`_threads`) and how
-    many independent kernel calls may run at once (:func:`run_tasks`): ``OMP_NUM_THREADS``
-    or :func:`set_num_threads`, one while the machine is busy."""
-    n = _USER_THREADS
-    if ADAPT_TO_LOAD and n > 1 and _machine_busy():
-        n = 1
-    return n
-
-
-def run_tasks(fn: Callable[[Any], _R], items, sizes) -> list[_R]:
-    """``[fn(x) for x in items]``, concurrently on up to :func:`task_workers` threads.
-
-    ``fn`` must release the GIL for its work (the compiled kernels do) and its calls must
-    not depend on each other's results.  ``sizes`` (one number per item, its work) orders
-    the start: largest first, so the longest call does not start last (LPT scheduling).
-    Each kernel call inside runs single-threaded, and a kernel's bits do not depend on its
-    thread count, so the results are those of the serial loop, bit for bit.  Serial when
-    one worker is allowed, for one item, or below :data:`TASKS_MIN_WORK` in all.  An
-    exception is raised as from the serial loop (the first item's that raised, in order).
-    """
-    items = list(items)
-    workers = min(task_workers(), len(items))
-    if workers <= 1 or float(np.sum(sizes)) < TASKS_MIN_WORK:
-        return [fn(x) for x in items]
-    if not _TASK_POOL:
-        from concurrent.futures import ThreadPoolExecutor   # lazily: most calls never need it
-        _TASK_POOL.append(ThreadPoolExecutor(max_workers=max(1, _CPU_COUNT - 1), thread_name_prefix="igl_hhj"))
-    pool = _TASK_POOL[0]
-    order = np.argsort(-np.asarray(sizes, dtype=np.float64), kind="stable")
-    # `workers` chains of calls: no more kernels at once than the policy allows
-    queue = list(order[::-1])
-    lock = threading.Lock()
-    out: list[Any] = [None] * len(items)
-
-    def chain():
-        while True:
-            with lock:
-                if not queue:
-                    return
-                i = int(queue.pop())
-            try:
-                out[i] = (True, fn(items[i]))
-            except BaseException as exc:  # re-raised below, in item order
-                out[i] = (False, exc)
-
-    futures = [pool.submit(chain) for _ in range(workers - 1)]
-    chain()                                       # the caller runs one chain itself
-    for future in futures:
-        future.result()
-    for ok, value in out:
-        if not ok:
-            raise value
-    return [value for _, value in out]
-
-
-# Heap policy of a large call (glibc; see igl_hhj/_core/heap.cpp).  glibc raises its mmap
-# threshold by itself only up to 32 MiB, so above about 930k faces each (#E, 3) float64
-# work array is a fresh mapping whose pages all fault on first touch (icosphere(8): 400k
-# minor faults per drop-in call).  Inside the scope the call's arrays come from the heap
-# and are reused between stages; on exit glibc's 32 MiB ceiling is restored and the freed
-# heap is returned (malloc_trim), so no memory is kept between calls.  Measured on
-# icosphere(8): 400k -> 181k faults, drop-in 2.58 -> 2.27 s; no effect below 32 MiB.
-# False: never touch the allocator.  A policy set through MALLOC_MMAP_THRESHOLD_,
-# MALLOC_TRIM_THRESHOLD_ or GLIBC_TUNABLES=glibc.malloc.* is always left alone.
-LARGE_CALL_HEAP = True
-_GLIBC_MMAP_CEILING = 32 << 20
-# the scope's threshold, in units of the call's (#E, 3) float64 array: its edge and vertex
-# work arrays come from the heap, the few larger ones ((#E, 5) matrix rows) stay mappings.
-# Measured on icosphere(8) (threshold 1.5x: 71 MB): 2.13 s, peak 0.57 KB/face, as without
-# the scope; 128 MB and above: 2.03 s but 0.60 KB/face (freed large blocks linger in the
-# heap); 32 MB: 2.45 s
-_HEAP_SCOPE_FACTOR = 1.5
-
-
-def _user_malloc_policy():
-    env = os.environ
-    return ("MALLOC_MMAP_THRESHOLD_" in env or "MALLOC_TRIM_THRESHOLD_" in env
-            or "glibc.malloc." in env.get("GLIBC_TUNABLES", ""))
-
-
-@contextmanager
-def large_call_heap(n_faces: float) -> Iterator[bool]:
-    """Open the large-call heap scope for a call on a mesh of ``n_faces`` faces.
-
-    Yields True when the scope is active: the mesh's (#E, 3) float64 work arrays
-    (#E ≈ 1.5 #F) exceed glibc's 32 MiB dynamic mmap ceiling, :data:`LARGE_CALL_HEAP`
-    is on and no user malloc policy is set in the environment.  Nests, thread-safe."""
-    big = 1.5 * float(n_faces) * 3 * 8
-    if not LARGE_CALL_HEAP or big <= _GLIBC_MMAP_CEILING or _user_malloc_policy():
-        yield False
-        return
-    active = _core.heap_scope_enter(int(_HEAP_SCOPE_FACTOR * big))
-    try:
-        yield active
-    finally:
-        _core.heap_scope_exit()
-
-
-def _n_faces_hint(V, F):
-    """Number of faces of the call ``f(V, F, ...)`` without validating (0 if unknown)."""
-    if F is None:
-        return int(getattr(V, "n_faces", 0) or 0)
-    shape = getattr(F, "shape", None)
-    try:
-        return int(shape[0]) if shape else len(F)
-    except (TypeError, IndexError, ValueError):
-        return 0
-
-
-_P = ParamSpec("_P")
-_R = TypeVar("_R")
-
-
-def with_large_call_heap(fn: Callable[_P, _R]) -> Callable[_P, _R]:
-    """Decorator for public functions called as ``fn(V, F, ...)``: runs them inside
-    :func:`large_call_heap`.
-
-    The signature is kept for static checkers (``Callable[P, R] -> Callable[P, R]``:
-    mypy and IDEs see the decorated function's own parameters and return type) and at
-    run time (``functools.wraps``; ``inspect`` follows ``__wrapped__``)."""
-    @functools.wraps(fn)
-    def wrapper(*args: _P.args, **kwargs: _P.kwargs) -> _R:
-        V = args[0] if args else kwargs.get("V")
-        F = args[1] if len(args) > 1 else kwargs.get("F")
-        with large_call_heap(_n_faces_hint(V, F)):
-            return fn(*args, **kwargs)
-    return wrapper
+sys.modules[__name__].__class__ = _Kernels
 
 
 def topology(F, n_vertices):
@@ -702,3 +522,11 @@ def intrinsic_smoothing(mesh, X, C, mass, phase, rough, radius, *, per_radius, p
                                      float(per_radius), float(pilot_radius), float(pilot_rtol), float(gain),
                                      float(power), float(bounds[0]), float(bounds[1]), int(steps),
                                      [float(c) for c in coefficients], float(rtol), int(maxiter))
+
+
+def dropin_small(V, F, N, cot, checks, smoothing, binom):
+    """The whole drop-in on a small mesh in one call (``_core/small_mesh.cpp``; the caller,
+    :func:`igl_hhj.small_mesh.try_dropin`, checks the arrays and passes the constants).
+    Returns ``(status, PD1, PD2, PV1, PV2, bad)``, status 0 when the compiled path applies.
+    Single-threaded by construction: no thread policy to apply."""
+    return _core.dropin_small(V, F, N, cot, checks, smoothing, binom)

@@ -91,10 +91,10 @@ def try_dropin(V, F, radius, rtol, boundary="estimate"):
         return None
     import igl
 
-    from . import _hhj_core
+    from . import kernels
     N = igl.per_vertex_normals(V, F, area)
     cot = igl.cotmatrix_entries(V, F)
-    status, PD1, PD2, PV1, PV2, bad = _hhj_core.dropin_small(
+    status, PD1, PD2, PV1, PV2, bad = kernels.dropin_small(
         V, F, np.ascontiguousarray(N, dtype=np.float64), np.ascontiguousarray(cot, dtype=np.float64),
         checks[boundary],
         (float(radius), smoothing[0], smoothing[1], smoothing_rtol(rtol), *smoothing[2:], int(maxiter)), binom)

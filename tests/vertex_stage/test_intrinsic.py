@@ -9,7 +9,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import igl_hhj
-from igl_hhj import intrinsic, kernels
+from igl_hhj import intrinsic, kernels, runtime
 from igl_hhj.benchmarks.vertex_stage import tube_torus
 from igl_hhj import recovery as rc
 from igl_hhj.mesh import TriangleMesh
@@ -249,7 +249,7 @@ def test_smoothing_by_parts_is_each_parts_own_smoothing():
 
 
 def test_run_tasks_is_the_serial_loop(monkeypatch):
-    """kernels.run_tasks: the results of the serial loop in item order, whatever the number
+    """runtime.run_tasks: the results of the serial loop in item order, whatever the number
     of workers and the start order (largest first); the first item's exception in item
     order; serial below TASKS_MIN_WORK or with one worker."""
     import threading
@@ -260,26 +260,26 @@ def test_run_tasks_is_the_serial_loop(monkeypatch):
         if x in (3, 5):
             raise KeyError(x)
         return x * x
-    monkeypatch.setattr(kernels, "task_workers", lambda: 2)
-    sizes = [kernels.TASKS_MIN_WORK] * 3
-    assert kernels.run_tasks(fn, [0, 1, 2], sizes) == [0, 1, 4]
+    monkeypatch.setattr(runtime, "task_workers", lambda: 2)
+    sizes = [runtime.TASKS_MIN_WORK] * 3
+    assert runtime.run_tasks(fn, [0, 1, 2], sizes) == [0, 1, 4]
     assert {x for x, _ in seen} == {0, 1, 2}
     seen.clear()
-    assert kernels.run_tasks(fn, [7, 8, 9], [1, 5, kernels.TASKS_MIN_WORK]) == [49, 64, 81]
+    assert runtime.run_tasks(fn, [7, 8, 9], [1, 5, runtime.TASKS_MIN_WORK]) == [49, 64, 81]
     assert seen[0][0] == 9                                  # the largest item starts first
     with pytest.raises(KeyError, match="3"):
-        kernels.run_tasks(fn, [1, 3, 5, 2], [kernels.TASKS_MIN_WORK] * 4)
+        runtime.run_tasks(fn, [1, 3, 5, 2], [runtime.TASKS_MIN_WORK] * 4)
     seen.clear()
-    assert kernels.run_tasks(fn, [1, 2], [1, 1]) == [1, 4]     # too little work: the caller alone
+    assert runtime.run_tasks(fn, [1, 2], [1, 1]) == [1, 4]     # too little work: the caller alone
     assert {t for _, t in seen} == {threading.current_thread().name}
-    monkeypatch.setattr(kernels, "task_workers", lambda: 1)
+    monkeypatch.setattr(runtime, "task_workers", lambda: 1)
     seen.clear()
-    assert kernels.run_tasks(fn, [1, 2], sizes[:2]) == [1, 4]
+    assert runtime.run_tasks(fn, [1, 2], sizes[:2]) == [1, 4]
     assert {t for _, t in seen} == {threading.current_thread().name}
 
 
 def test_smoothing_by_parts_concurrent_is_serial_bit_for_bit(monkeypatch):
-    """The sides of a cut smoothed on two threads at once (kernels.run_tasks) are the serial
+    """The sides of a cut smoothed on two threads at once (runtime.run_tasks) are the serial
     loop's values bit for bit: each call runs single-threaded and a kernel's bits do not
     depend on its thread count."""
     from igl_hhj import features as ft
@@ -302,9 +302,9 @@ def test_smoothing_by_parts_concurrent_is_serial_bit_for_bit(monkeypatch):
         threads.append(threading.current_thread().name)
         return orig(*a, **k)
     monkeypatch.setattr(kernels, "intrinsic_smoothing", spy)
-    monkeypatch.setattr(kernels, "ADAPT_TO_LOAD", False)
+    monkeypatch.setattr(runtime, "ADAPT_TO_LOAD", False)
     for workers in (1, 2):
-        monkeypatch.setattr(kernels, "task_workers", lambda w=workers: w)
+        monkeypatch.setattr(runtime, "task_workers", lambda w=workers: w)
         threads.clear()
         Y = X.copy()
         res = intrinsic.adaptive_smoothing_by_parts(cm, Y, *args, scale_groups=np.zeros(len(cut.V), dtype=int))
