@@ -854,7 +854,7 @@ def dropin_on_mesh(mesh, radius, boundary, boundary_normals, boundary_shape_oper
         # released (the default path does not read them again; if asked for, the numpy
         # property recomputes them, equal to round-off)
         mesh.vertex_normals
-        mesh.__dict__.pop("_cross", None)
+        mesh.release_face_cross_products()
     S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver,
                         rtol, estimated=treatment == "estimate", groups_of=groups_of)
     holder = [S]     # the only reference: the vertex stage frees S before smoothing

@@ -40,6 +40,7 @@ from typing import Any
 import numpy as np
 
 from .mesh import MeshWarning, validate_faces, validate_vertices, zero_area_faces
+from .mesh_objects import mesh_arrays
 
 __all__ = ["RepairedMesh", "repair_mesh", "vertex_values_to_caller", "face_values_to_caller",
            "REPAIR_KINDS"]
@@ -319,7 +320,6 @@ PER_VERTEX_KWARGS = ("boundary_normals", "boundary_shape_operator", "simply_supp
 
 def _mesh_arrays(V, F):
     if F is None:
-        from .interop import mesh_arrays
         arrays = mesh_arrays(V)
         if arrays is None:
             raise TypeError("F is required unless V is a TriangleMesh or a mesh object "

@@ -208,7 +208,6 @@ def test_every_module_has_a_layer():
     assert not missing, f"add these modules to MODULE_LAYER (tests/core/test_layers.py): {missing}"
 
 
-@pytest.mark.xfail(strict=True, reason="house-lib: the library layers are being rearranged")
 def test_imports_go_downward_only():
     rank = {name: i for i, name in enumerate(LAYERS)}
     upward = []

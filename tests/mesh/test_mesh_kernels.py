@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from igl_hhj import kernels
-from igl_hhj.mesh import TriangleMesh, topology_reference
+from igl_hhj.mesh import TriangleMesh
+from reference_topology import topology_reference
 from kernel_cases import kernel_meshes
 
 
