@@ -27,9 +27,10 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from .constants import SPD_AUTO_CG_MAXITER, SPD_AUTO_DIRECT_MAX
+from .constants import SPD_AUTO_DIRECT_MAX
 from .errors import SolverDidNotConverge
 from .mesh import TriangleMesh
+from .solvers import solve_spd  # the generic SPD solve, named here as before
 
 __all__ = [
     "local_basis", "mass_matrix", "jump_matrix", "face_tensors", "nn_moments",
@@ -245,141 +246,6 @@ def _robust_block_inverse(blk):
     ci /= det[:, None, None]
     ci[~ok] = np.eye(3)
     return ci * d[:, :, None] * d[:, None, :]
-
-
-def solve_spd(A, R, *, method="auto", rtol=1e-10, maxiter=None, preconditioner=None):
-    """Solve ``A X = R`` for an SPD sparse A and all columns of R at once.
-
-    Parameters
-    ----------
-    A : (n, n) scipy.sparse SPD matrix
-    R : (n,) or (n, k) right-hand sides
-    method : {"auto", "cg", "direct"}
-        "cg": the compiled fused block PCG (:func:`igl_hhj.kernels.block_pcg`)
-        over the k columns, preconditioned by ``preconditioner`` (a sparse SPD
-        approximation of A⁻¹, e.g. :func:`face_schwarz_preconditioner`) or,
-        without one, Jacobi.
-        "direct": one sparse factorisation (:func:`igl_hhj.solvers.cholesky_solve`:
-        QDLDL up to 200k unknowns, CHOLMOD via cholespy above, pivoted SuperLU when the
-        residual check fails).
-        "auto": direct up to ``SPD_AUTO_DIRECT_MAX`` (50 000) unknowns; above,
-        PCG, switching to the direct solver as soon as the measured
-        convergence rate predicts more than ``maxiter`` (default
-        ``SPD_AUTO_CG_MAXITER`` = 600) further iterations (checked every 20 iterations).
-    rtol : float
-        CG stops when ``‖r_j‖ ≤ rtol ‖R_j‖`` for every column j.  The default
-        1e-10 leaves a solver error far below every discretisation error in
-        the convergence tables (tests compare CG with the direct solve).
-    maxiter : int, optional
-        CG iteration cap (default 2000 for "cg", 600 for "auto").
-    preconditioner : (n, n) scipy.sparse matrix, optional
-        Applied as ``z = M r``.  Anything else with ``@`` (e.g. a
-        ``LinearOperator``) runs the numpy reference PCG :func:`_block_pcg`.
-
-    Raises
-    ------
-    SolverDidNotConverge
-        method="cg" and CG did not reach ``rtol`` within ``maxiter`` iterations.
-    """
-    from . import solvers
-    R = np.asarray(R, dtype=np.float64)
-    vec = R.ndim == 1
-    if vec:
-        R = R[:, None]
-    n = A.shape[0]
-    if method not in ("auto", "cg", "direct"):
-        raise ValueError(f"unknown solver method {method!r}; use 'auto', 'cg' or 'direct'")
-    if method == "auto" and n <= SPD_AUTO_DIRECT_MAX:
-        method = "direct"
-    X = None
-    if maxiter is None:
-        maxiter = SPD_AUTO_CG_MAXITER if method == "auto" else 2000
-    if method in ("cg", "auto") and n > 0:
-        if preconditioner is not None and not sp.issparse(preconditioner):
-            try:
-                X = _block_pcg(sp.csr_matrix(A), R, rtol, maxiter, preconditioner)
-            except SolverDidNotConverge:
-                if method == "cg":
-                    raise
-        else:
-            Ac = sp.csr_matrix(A)
-            Mc = None
-            dinv = None
-            if preconditioner is None:
-                dinv = 1.0 / Ac.diagonal()
-            else:
-                Mc = sp.csr_matrix(preconditioner)
-                Mc = (Mc.indptr, Mc.indices, Mc.data)
-            Xc, it, status, relres = solvers.pcg(
-                Ac.indptr, Ac.indices, Ac.data, R, rtol=rtol, maxiter=maxiter, M=Mc, dinv=dinv,
-                probe_iter=20 if method == "auto" else 0, max_predicted=maxiter)
-            if status == 0:
-                X = Xc
-            elif method == "cg":
-                raise SolverDidNotConverge(
-                    f"preconditioned CG did not converge in {it} iterations "
-                    f"(relative residual {max(relres):.2e} > {rtol:.1e}); the mesh may contain "
-                    f"near-degenerate triangles. Use solver='direct' or solver='auto'.")
-    if X is None:
-        X = np.zeros_like(R) if n == 0 else solvers.cholesky_solve(A, R)
-    return X[:, 0] if vec else X
-
-
-def _block_pcg(A, R, rtol, maxiter, M=None):
-    """The numpy reference of the compiled block PCG: CG on the columns of R at once (independent recurrences,
-    shared sparse products).  Buffers are reused: at 10⁵–10⁶ unknowns each
-    iteration is memory-bound."""
-    n, k = R.shape
-    if maxiter is None:
-        maxiter = 2000
-    if M is None:
-        dinv = (1.0 / A.diagonal())[:, None]
-        def apply(r):  # noqa: E306
-            return dinv * r
-    else:
-        def apply(r):  # noqa: E306
-            return M @ r
-    tmp = np.empty((n, k))
-    ones = np.ones(n)
-
-    def coldot(a, b):  # column-wise dot products; `ones @` is a BLAS gemv, 50x faster than .sum(0)
-        np.multiply(a, b, out=tmp)
-        return ones @ tmp
-
-    X = np.zeros((n, k))
-    r = R.copy()
-    bb = coldot(R, R)
-    tol2 = (rtol ** 2) * bb
-    rr = bb
-    active = rr > tol2
-    if not active.any():
-        return X
-    z = apply(r)
-    p = z.copy()
-    rz = coldot(r, z)
-    for _ in range(maxiter):
-        q = A @ p
-        pq = coldot(p, q)
-        alpha = np.where(active, rz / np.where(active, pq, 1.0), 0.0)
-        np.multiply(p, alpha, out=tmp)
-        X += tmp
-        np.multiply(q, alpha, out=tmp)
-        r -= tmp
-        rr = coldot(r, r)
-        active = rr > tol2
-        if not active.any():
-            return X
-        z = apply(r)
-        rz_new = coldot(r, z)
-        beta = np.where(active, rz_new / np.where(active, rz, 1.0), 0.0)
-        rz = rz_new
-        p *= beta
-        p += z
-    worst = float(np.max(np.sqrt(rr / np.where(bb > 0, bb, 1.0))))
-    raise SolverDidNotConverge(
-        f"preconditioned CG did not converge in {maxiter} iterations "
-        f"(relative residual {worst:.2e} > {rtol:.1e}); the mesh may contain "
-        f"near-degenerate triangles. Use solver='direct' or solver='auto'.")
 
 
 class HHJProjection:

@@ -221,7 +221,7 @@ def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,
     Column indices travel as int32 (memory bandwidth: the sweeps are memory-bound).  Row
     pointers: int32 when those of A and of M both are (passed without a copy, e.g.
     :func:`ell_indptr`'s), else int64.
-    Reference: :func:`igl_hhj.hhj._block_pcg`.  Preconditioner: ``M`` =
+    Reference: :func:`igl_hhj.solvers._block_pcg`.  Preconditioner: ``M`` =
     ``(indptr, indices, data)`` of a CSR matrix, else Jacobi with ``dinv``; with
     ``subdomain`` (int64 indices S) and ``subdomain_solve(r_S, z_S)`` (writes
     ``z_S = C r_S`` into its second argument, (|S|, k) float64) a second level

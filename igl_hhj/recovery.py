@@ -128,7 +128,7 @@ def _square(A, n):
 def _solve(A, R, ref, rtol):
     """Solve on the referenced vertices (CG, Jacobi; direct if CG stalls)."""
     from .errors import SolverDidNotConverge
-    from .hhj import solve_spd
+    from .solvers import solve_spd
     X = np.full(R.shape, np.nan)
     idx = np.flatnonzero(ref)
     Ar = A if ref.all() else A[idx][:, idx]

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..hhj import solve_spd
+from ..solvers import solve_spd
 from .field import CurvedField
 from .reference import edge_node_slots, lagrange_basis, triangle_quadrature
 from .surface import ElementGeometry, LagrangeSurface

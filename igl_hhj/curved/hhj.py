@@ -39,7 +39,7 @@ from functools import cached_property
 import numpy as np
 import scipy.sparse as sp
 
-from ..hhj import solve_spd
+from ..solvers import solve_spd
 
 from .reference import (CORNERS, EDGE_OUTWARD, EDGE_TANGENTS, lagrange_basis, lagrange_nodes,
                         line_quadrature, triangle_quadrature)
