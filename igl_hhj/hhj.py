@@ -27,6 +27,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from .boundary import clamped_load  # the boundary load, named here as before
 from .constants import SPD_AUTO_DIRECT_MAX
 from .errors import SolverDidNotConverge
 from .mesh import TriangleMesh
@@ -129,39 +130,6 @@ def nn_moments(mesh: TriangleMesh, sigma):
     For a member of V_h the two faces of an interior edge agree."""
     n = mesh.conormals
     return np.einsum("fia,fab,fib->fi", n, sigma, n)
-
-
-def clamped_load(mesh: TriangleMesh, edge_mask, gradient):
-    """Clamped boundary load ``g_e = ∫_e n·ξ ds`` for P1-interpolated data ξ.
-
-    Parameters
-    ----------
-    edge_mask : (#E,) bool, edges receiving data (boundary edges).
-    gradient : (#V, k, 3) surface gradients ξ of k functions at the vertices
-        (rows of vertices not on a masked edge are ignored).
-
-    Returns
-    -------
-    g : (#E, k) float64, zero off the mask.  Exact for linear ξ along the edge.
-    """
-    k = gradient.shape[1]
-    g = np.zeros((mesh.n_edges, k))
-    e = np.flatnonzero(edge_mask)
-    if e.size == 0:
-        return g
-    f = mesh.edge_faces[e, 0]
-    f = np.where(f >= 0, f, mesh.edge_faces[e, 1])
-    i = np.where(mesh.edge_faces[e, 0] >= 0, mesh.edge_local_index[e, 0], mesh.edge_local_index[e, 1])
-    n = mesh.conormals_at(f, i)                   # (m, 3)
-    va, vb = mesh.edges[e, 0], mesh.edges[e, 1]
-    xi = 0.5 * (gradient[va] + gradient[vb])      # (m, k, 3) mean over the edge
-    # n·ξ summed (n0 ξ0 + n1 ξ1) + n2 ξ2 in this order on every machine (einsum's order
-    # depends on the SIMD width), as the compiled small-mesh path (igl_hhj.small_mesh)
-    s = n[:, None, 0] * xi[:, :, 0]
-    s += n[:, None, 1] * xi[:, :, 1]
-    s += n[:, None, 2] * xi[:, :, 2]
-    g[e] = mesh.unique_edge_lengths[e, None] * s
-    return g
 
 
 def face_schwarz_preconditioner(mesh: TriangleMesh, A, phi=None, free=None):

@@ -37,7 +37,7 @@ from .mesh import TriangleMesh
 
 __all__ = [
     "face_quality", "recovery_weights", "recovery_operator", "vertex_confidence", "QUALITY_FLOOR", "recover_vertex_tensors", "smooth_vertex_tensors",
-    "smoothing_length", "smoothing_matrices", "smoothing_coefficients", "recover_and_smooth", "patch_recover", "smooth_recovered", "boundary_band", "BOUNDARY_LENGTH_FACTOR", "SMOOTHING_PER_RADIUS", "SMOOTHING_STEPS", "SMOOTHING_ORDER", "tangent_projection",
+    "smoothing_length", "smoothing_matrices", "smoothing_coefficients", "recover_and_smooth", "patch_recover", "smooth_recovered", "boundary_band", "BOUNDARY_LENGTH_FACTOR", "SMOOTHING_PER_RADIUS", "SMOOTHING_STEPS", "SMOOTHING_ORDER", "tangent_projection", "kernel_coefficients",
 ]
 
 
@@ -387,7 +387,7 @@ def smooth_vertex_tensors(mesh: TriangleMesh, Sv, N, length, *, steps=SMOOTHING_
     # (I - (I - G)^order) X0 = Σ_j binom(order, j) (-1)^(j+1) G^j X0
     X = np.zeros_like(X0)
     Y = X0
-    for c in _kernel_coefficients(order):
+    for c in kernel_coefficients(order):
         for _ in range(steps):
             Y = _diffuse(A, L, Y, ref, t, rtol)
         X += c * Y
@@ -396,7 +396,7 @@ def smooth_vertex_tensors(mesh: TriangleMesh, Sv, N, length, *, steps=SMOOTHING_
     return out
 
 
-def _kernel_coefficients(order):
+def kernel_coefficients(order):
     """binom(order, j) (-1)^(j+1), j = 1..order: ``I - (I - G)^order = Σ_j c_j G^j``."""
     from math import comb
     return [comb(order, j) * (-1) ** (j + 1) for j in range(1, order + 1)]
@@ -455,7 +455,7 @@ def smooth_recovered(mesh: TriangleMesh, X, N, w, length, *, steps=SMOOTHING_STE
     if length > 0:
         C, m = smoothing_coefficients(mesh, w)
         status, _ = kernels.smooth_vertex_tensors(mesh, X, C, m, length ** 2 / steps, steps,
-                                                  _kernel_coefficients(order), rtol, 500)
+                                                  kernel_coefficients(order), rtol, 500)
         del C, m
         if status != 0:      # a diffusion solve stalled (X unchanged): the reference's direct fallback
             Sv = np.full((mesh.n_vertices, 3, 3), np.nan)

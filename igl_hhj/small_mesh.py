@@ -47,7 +47,7 @@ def _params():
         from .constants import (BOUNDARY_BAND_RINGS, BOUNDARY_LENGTH_FACTOR, COORDINATE_MAX,
                                 DEGENERATE_AREA_RTOL, DIRECT_RESIDUAL_RTOL, FIT_RINGS, FOLDED_NORMAL_RTOL,
                                 MIN_MESH_SIZE, QUALITY_FLOOR, SIDE_DOT_MIN, SMOOTHING_PER_RADIUS)
-        from .recovery import _kernel_coefficients
+        from .recovery import kernel_coefficients
         head = (DEGENERATE_AREA_RTOL, MIN_MESH_SIZE, FOLDED_NORMAL_RTOL, QUALITY_FLOOR,
                 DIRECT_RESIDUAL_RTOL, MAX_EDGES)
         tail = (int(FIT_RINGS), float(SIDE_DOT_MIN), int(BOUNDARY_BAND_RINGS), float(BOUNDARY_LENGTH_FACTOR))
@@ -55,7 +55,7 @@ def _params():
         smoothing = (SMOOTHING_PER_RADIUS, float(it.PILOT_RADIUS), float(it.ADAPTIVE_GAIN),
                      float(it.ADAPTIVE_POWER), float(it.ADAPTIVE_RANGE[0]), float(it.ADAPTIVE_RANGE[1]),
                      int(it.SMOOTHING_STEPS))
-        binom = [float(c) for c in _kernel_coefficients(it.SMOOTHING_ORDER)]
+        binom = [float(c) for c in kernel_coefficients(it.SMOOTHING_ORDER)]
         area = igl.PerVertexNormalsWeightingType.PER_VERTEX_NORMALS_WEIGHTING_TYPE_AREA
         _PARAMS = (checks, smoothing, binom, it.smoothing_rtol, it.SMOOTHING_MAXITER, COORDINATE_MAX, area)
     return _PARAMS

@@ -23,6 +23,11 @@ FROZEN = Path(__file__).with_name("documented_names.txt")
 REMOVED = {
     # dotted name: why it is gone (docs/changelog.md)
     "igl_hhj.mesh.topology_reference": "a numpy reference only the tests used: tests/mesh/reference_topology.py",
+    "igl_hhj.features.dihedral_magnitudes_reference":
+        "a numpy reference only the tests used: tests/vertex_stage/reference_creases.py",
+    **{f"igl_hhj.intrinsic.{n}": "the numpy reference of the recovery, only the tests used it: "
+       "tests/vertex_stage/reference_intrinsic.py (igl_hhj.intrinsic is the compiled vertex stage)"
+       for n in ("corner_components", "recover", "roughness", "principal", "vertex_stage_reference")},
 }
 
 DOTTED = re.compile(r"igl_hhj(?:\.[A-Za-z_][A-Za-z0-9_]*)+")

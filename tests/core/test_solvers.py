@@ -323,17 +323,3 @@ def test_envelope_ldl_agrees_with_the_sparse_direct_solve():
     _, status = kernels.envelope_ldl_solve(indptr, np.array([0, 5, 0, 1], dtype=np.int32),
                                            np.array([2.0, 1.0, 1.0, 2.0]), np.ones((2, 1)), 1e-8)
     assert status == 3
-
-
-def test_tiny_meshes_take_the_envelope_solve_and_match_the_reference(monkeypatch):
-    """A drop-in call on a tiny mesh uses the compiled envelope solve, never scipy's
-    sparse factorisation, and its shape operator is the numpy reference's."""
-    from igl_hhj import curvature, solvers
-    V, F = icosphere(1)
-    called = []
-    monkeypatch.setattr(solvers, "cholesky_solve", lambda *a, **k: called.append(1))
-    S = curvature.shape_operator(V, F)
-    assert not called
-    monkeypatch.undo()
-    ref = curvature._shape_operator_reference(as_mesh(V, F))
-    assert np.abs(S - ref).max() <= 1e-10 * np.abs(ref).max()

@@ -8,11 +8,13 @@ from conftest import sequence
 
 import igl_hhj
 from igl_hhj import kernels
-from igl_hhj.curvature import _shape_operator, _shape_operator_reference
+from igl_hhj.curvature import _shape_operator
 from igl_hhj.errors import SolverError
 from igl_hhj.hhj import HHJProjection, face_schwarz_preconditioner, face_tensors, jump_matrix, mass_matrix
-from igl_hhj.mesh import DEGENERATE_AREA_RTOL, TriangleMesh
+from igl_hhj.mesh import DEGENERATE_AREA_RTOL, TriangleMesh, as_mesh
+from igl_hhj.surfaces import icosphere
 from igl_hhj.surfaces.boundary_data import exact_boundary_normals, exact_boundary_shape_operator
+from reference_shape_operator import shape_operator_reference
 from kernel_cases import RTOL, bumpy, closed, kernel_meshes, rel, saddle, sliver_mesh  # noqa: F401 (closed, saddle: pytest fixtures)
 
 
@@ -63,7 +65,7 @@ def test_shape_operator_equals_reference_with_boundary_data(saddle, case, solver
     kw = _boundary_cases(surface, m)[case]
     S = _shape_operator(m, kw.get("boundary_normals"), kw.get("boundary_shape_operator"),
                         kw.get("simply_supported"), solver, rtol=1e-13)
-    R = _shape_operator_reference(m, **kw)
+    R = shape_operator_reference(m, **kw)
     assert rel(S, R) <= RTOL
 
 
@@ -72,7 +74,7 @@ def test_shape_operator_equals_reference_with_boundary_data(saddle, case, solver
 def test_shape_operator_equals_reference(name, solver):
     m = TriangleMesh(*kernel_meshes()[name])
     S = _shape_operator(m, None, None, None, solver, rtol=1e-13)
-    R = _shape_operator_reference(m)
+    R = shape_operator_reference(m)
     assert np.isfinite(S).all()
     assert rel(S, R) <= RTOL
 
@@ -169,3 +171,17 @@ def test_boundary_normal_fits_reject_bad_arrays():
         kernels.boundary_normal_fits(m, verts, 0, N0)
     with pytest.raises(ValueError, match="out of range"):
         kernels.boundary_normal_fits(m, np.r_[verts[:-1], m.n_vertices], 3, N0)
+
+
+def test_tiny_meshes_take_the_envelope_solve_and_match_the_reference(monkeypatch):
+    """A drop-in call on a tiny mesh uses the compiled envelope solve, never scipy's
+    sparse factorisation, and its shape operator is the numpy reference's."""
+    from igl_hhj import curvature, solvers
+    V, F = icosphere(1)
+    called = []
+    monkeypatch.setattr(solvers, "cholesky_solve", lambda *a, **k: called.append(1))
+    S = curvature.shape_operator(V, F)
+    assert not called
+    monkeypatch.undo()
+    ref = shape_operator_reference(as_mesh(V, F))
+    assert np.abs(S - ref).max() <= 1e-10 * np.abs(ref).max()

@@ -6,23 +6,19 @@ import pytest
 
 import igl_hhj
 from igl_hhj import kernels
-from igl_hhj.curvature import (
-    _principal_from_shape_operator_reference, _shape_operator, _shape_operator_reference,
-    _vertex_shape_operator_reference, principal_from_shape_operator,
-)
+from igl_hhj.curvature import _shape_operator, principal_from_shape_operator
 from igl_hhj.mesh import TriangleMesh
 from igl_hhj.surfaces import Sphere, icosphere, jitter_tangentially
+from reference_intrinsic import principal_from_shape_operator_reference, recover, roughness
 from kernel_cases import RTOL, bumpy, closed, kernel_meshes, on_one_and_two_threads, rel, sliver_mesh  # noqa: F401 (closed, saddle: pytest fixtures)
 
 
-def test_recovery_and_eigen_equal_reference(closed):
-    S = _shape_operator_reference(closed)
-    N = closed.vertex_normals
-    Sv = kernels.lumped_vertex_recovery(closed, S, N)
-    Sv_ref, _ = _vertex_shape_operator_reference(closed, S)
-    assert rel(Sv, Sv_ref) <= RTOL
+def test_eigen_equals_reference(closed):
+    from igl_hhj import recovery as rc
+    S = _shape_operator(closed, None, None, None, "direct")
+    Sv, N = rc.recover_vertex_tensors(closed, S, method="lumped")     # tangential vertex tensors
     PD1, PD2, PV1, PV2 = principal_from_shape_operator(Sv, N)
-    rPD1, rPD2, rPV1, rPV2 = _principal_from_shape_operator_reference(Sv, N)
+    rPD1, rPD2, rPV1, rPV2 = principal_from_shape_operator_reference(Sv, N)
     assert rel(PV1, rPV1) <= RTOL and rel(PV2, rPV2) <= RTOL
     gap = (rPV1 - rPV2) > 1e-6 * np.abs(rPV1).max()
     assert gap.mean() > 0.9
@@ -76,7 +72,6 @@ def test_patch_fit_of_vertices_whose_faces_all_weigh_zero(closed):
     """The compiled patch fit gathers each vertex's corners; a vertex whose corners all weigh 0
     falls back to the plain average of its faces (weight 1 each) there too: the compiled
     recoveries equal the numpy references on a mesh with such vertices."""
-    from igl_hhj import intrinsic
     from igl_hhj import recovery as rc
     S = _shape_operator(closed, None, None, None, "direct")
     N = closed.vertex_normals
@@ -88,8 +83,8 @@ def test_patch_fit_of_vertices_whose_faces_all_weigh_zero(closed):
     Sv, _ = rc.recover_vertex_tensors(closed, S, weights=w)
     assert rel(rc._from6(X), Sv) <= 1e-13
     Xi, rough = kernels.intrinsic_patch_recovery(closed, S, N, w)
-    assert rel(Xi, intrinsic.recover(closed, S, N, w)) <= 1e-13
-    assert rel(rough, intrinsic.roughness(closed, S, N, Xi, w)) <= 1e-13
+    assert rel(Xi, recover(closed, S, N, w)) <= 1e-13
+    assert rel(rough, roughness(closed, S, N, Xi, w)) <= 1e-13
     assert np.isfinite(Xi).all() and np.abs(Xi[lost]).max() > 0
 
 
@@ -242,11 +237,11 @@ def test_dropin_frees_the_face_tensors_before_its_memory_peak(monkeypatch):
     smoothing (its memory peak), and gives the same values as the public composition."""
     import weakref
 
-    from igl_hhj import curvature
+    from igl_hhj import curvature, pipeline
     V, F = icosphere(4)
     V = jitter_tangentially(V, F, Sphere(), 0.3, seed=1)
     alive = {}
-    real_S, real_smooth = curvature._shape_operator, kernels.intrinsic_smoothing
+    real_S, real_smooth = pipeline.face_shape_operator, kernels.intrinsic_smoothing
 
     def shape_operator(*a, **k):
         S = real_S(*a, **k)
@@ -256,7 +251,7 @@ def test_dropin_frees_the_face_tensors_before_its_memory_peak(monkeypatch):
     def smooth(*a, **k):
         alive["at smoothing"] = alive["S"]() is not None
         return real_smooth(*a, **k)
-    monkeypatch.setattr(curvature, "_shape_operator", shape_operator)
+    monkeypatch.setattr(pipeline, "face_shape_operator", shape_operator)
     monkeypatch.setattr(kernels, "intrinsic_smoothing", smooth)
     out = igl_hhj.principal_curvature(V, F)
     assert alive["at smoothing"] is False
