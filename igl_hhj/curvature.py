@@ -358,14 +358,15 @@ def vertex_shape_operator(mesh, S, *, smoothing=0, recovery="intrinsic"):
     linear least-squares patch fit, and (``smoothing > 0``) smoothed by the twiced
     implicit diffusion of its trace (scalar cotangent Laplacian) and its deviator
     (spin-2 connection Laplacian) at the per-face length
-    ``ℓ_T = SMOOTHING_PER_RADIUS · smoothing · h_T``.
+    ``ℓ_T = SMOOTHING_PER_RADIUS · r_T · h_T``, ``r_T`` the adaptive radius at scale
+    ``smoothing`` (see :func:`principal_curvature`'s ``radius``).
 
-    The ambient variants average the 3×3 tensors of the incident faces and project
-    the result onto the vertex plane (biased where the normal turns fast, e.g. thin
-    tubes; kept for comparison): "patch" (linear fit), "lumped" (weighted average)
-    and "consistent" (consistent-mass L2 projection), each followed for
-    ``smoothing > 0`` by :func:`igl_hhj.recovery.smooth_vertex_tensors` at the
-    global length ``ℓ = SMOOTHING_PER_RADIUS · smoothing · h̄``.
+    The ambient variants, kept for comparison (numpy, :mod:`igl_hhj.recovery`), average
+    the 3×3 tensors of the incident faces and project the result onto the vertex plane
+    (biased where the normal turns fast, e.g. thin tubes): "patch" (linear fit), "lumped"
+    (weighted average) and "consistent" (consistent-mass L2 projection), each followed for
+    ``smoothing > 0`` by :func:`igl_hhj.recovery.smooth_vertex_tensors` at the global length
+    ``ℓ = SMOOTHING_PER_RADIUS · smoothing · h̄``.
 
     Returns
     -------
@@ -378,14 +379,6 @@ def vertex_shape_operator(mesh, S, *, smoothing=0, recovery="intrinsic"):
         Sv = _intrinsic.to_tensors(X, N)
         Sv[~mesh.referenced_vertices] = np.nan
         return Sv, N
-    if recovery == "patch":       # compiled (reference: _vertex_shape_operator_numpy)
-        length = _recovery.smoothing_length(mesh, smoothing) if smoothing > 0 else 0.0
-        return _recovery.recover_and_smooth(mesh, S, length)
-    return _vertex_shape_operator_numpy(mesh, S, smoothing=smoothing, recovery=recovery)
-
-
-def _vertex_shape_operator_numpy(mesh, S, *, smoothing=0, recovery="patch"):
-    """The readable numpy reference of :func:`vertex_shape_operator` (any ``recovery``)."""
     w = _recovery.recovery_weights(mesh)          # one computation for recovery and smoothing
     Sv, N = _recovery.recover_vertex_tensors(mesh, S, method=recovery, weights=w)
     if smoothing > 0:

@@ -27,9 +27,9 @@ from .runtime import (apply_thread_policy as _threads, core as _core, large_call
 
 __all__ = [
     "topology", "hhj_system", "jump_apply", "block_pcg", "shape_operator_faces",
-    "face_tensors", "lumped_vertex_recovery", "principal_2x2", "max_threads",
-    "set_num_threads", "ell_indptr", "edge_morton_order", "recovery_weights", "patch_recovery",
-    "tangent_projection6", "smooth_vertex_tensors", "face_metrics", "vertex_area_sums",
+    "face_tensors", "principal_2x2", "max_threads",
+    "set_num_threads", "ell_indptr", "edge_morton_order", "recovery_weights",
+    "face_metrics", "vertex_area_sums",
     "intrinsic_patch_recovery", "vertex_components", "transport_phases",
     "adaptive_radius", "principal_hz", "intrinsic_smoothing", "dihedral_magnitudes", "crease_cut",
     "run_tasks", "task_workers", "dropin_small",
@@ -303,19 +303,6 @@ def face_tensors(mesh, s):
     return _core.face_tensors(mesh.V, mesh.F, _i32(mesh.face_edges), s)
 
 
-def lumped_vertex_recovery(mesh, S, N):
-    """``S_v = P_v (Σ_T |T| S_T / Σ_T |T|) P_v`` (#V, 3, 3), ``P_v = I - N_v ⊗ N_v``.
-
-    Reference: :func:`igl_hhj.curvature.vertex_shape_operator` (the lumped
-    1-ring average).  ``S`` (#F, 3, 3), ``N`` (#V, 3); NaN rows for
-    unreferenced vertices."""
-    S = _f64(S, "S", (3, 3))
-    N = _f64(N, "N", (3,))
-    if S.shape[0] != mesh.n_faces or N.shape[0] != mesh.n_vertices:
-        raise ValueError("S must be (#F, 3, 3) and N (#V, 3)")
-    return _core.lumped_vertex_recovery(mesh.V, mesh.F, S, N)
-
-
 def principal_2x2(S, N):
     """Closed-form principal curvatures/directions of tangential tensors.
 
@@ -350,49 +337,6 @@ def _recovery_args(mesh, S, N, w, name):
     if S.shape[0] != mesh.n_faces or N.shape[0] != mesh.n_vertices or w.shape != (mesh.n_faces,):
         raise ValueError(f"{name}: S must be (#F, 3, 3), N (#V, 3) and w (#F,)")
     return S, N, w
-
-
-def patch_recovery(mesh, S, N, w, keep_trace=True):
-    """Patch recovery of face tensors at the vertices, tangent-projected, as 6 components.
-
-    Reference: :func:`igl_hhj.recovery.recover_vertex_tensors` (``method="patch"``).
-    ``S`` (#F, 3, 3), ``N`` (#V, 3) unit vertex normals, ``w`` (#F,) face weights →
-    (#V, 6) float64 in the component order of :data:`igl_hhj.recovery._SYM`
-    (rows of unreferenced vertices 0)."""
-    S, N, w = _recovery_args(mesh, S, N, w, "patch_recovery")
-    _threads()
-    return _core.patch_recovery(mesh.V, mesh.F, S, N, w, _ref_mask(mesh), float(mesh.mean_edge_length),
-                                bool(keep_trace))
-
-
-def tangent_projection6(mesh, X, N, keep_trace=True):
-    """In place on (#V, 6) components: ``P X P`` (+ the kept trace), reference
-    :func:`igl_hhj.recovery.tangent_projection`; unreferenced rows untouched."""
-    if not (isinstance(X, np.ndarray) and X.dtype == np.float64 and X.flags.c_contiguous
-            and X.shape == (mesh.n_vertices, 6)):
-        raise ValueError("tangent_projection6: X must be a C-contiguous float64 (#V, 6) array")
-    _threads()
-    _core.tangent_projection6(X, _f64(N, "N", (3,)), _ref_mask(mesh), bool(keep_trace))
-
-
-def smooth_vertex_tensors(mesh, X, C, mass, t, steps, coefficients, rtol, maxiter):
-    """Twiced implicit diffusion of the 6 tensor components ``X`` (#V, 6), in place.
-
-    Reference: :func:`igl_hhj.recovery.smooth_vertex_tensors`.  ``C`` (#F, 3) the
-    face-scaled cotangent entries, ``mass`` (#V,) the floored lumped mass, ``t`` the
-    step size, ``coefficients`` binom(order, j)(-1)^(j+1).  Returns ``(status,
-    iterations)``; status 0 when every PCG solve converged."""
-    if not (isinstance(X, np.ndarray) and X.dtype == np.float64 and X.flags.c_contiguous
-            and X.shape == (mesh.n_vertices, 6)):
-        raise ValueError("smooth_vertex_tensors: X must be a C-contiguous float64 (#V, 6) array")
-    C = _f64(C, "C", (3,))
-    mass = _f64(mass, "mass")
-    if C.shape[0] != mesh.n_faces or mass.shape != (mesh.n_vertices,):
-        raise ValueError("smooth_vertex_tensors: C must be (#F, 3) and mass (#V,)")
-    _threads()
-    return _core.smooth_vertex_tensors(_i32(mesh.edges), _i32(mesh.edge_faces), _i8(mesh.edge_local_index),
-                                       C, mass, X, float(t), int(steps), [float(c) for c in coefficients],
-                                       float(rtol), int(maxiter))
 
 
 def intrinsic_patch_recovery(mesh, S, N, w):

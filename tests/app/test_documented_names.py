@@ -28,6 +28,14 @@ REMOVED = {
     **{f"igl_hhj.intrinsic.{n}": "the numpy reference of the recovery, only the tests used it: "
        "tests/vertex_stage/reference_intrinsic.py (igl_hhj.intrinsic is the compiled vertex stage)"
        for n in ("corner_components", "recover", "roughness", "principal", "vertex_stage_reference")},
+    "igl_hhj.recovery.vertex_confidence": "dead code: no caller",
+    "igl_hhj.kernels.lumped_vertex_recovery": "dead code: one test called it (its C++ went with it)",
+    **{name: "the compiled twin of the ambient recovery, which only the non-default comparison option "
+       "vertex_shape_operator(recovery='patch') used (now served by the numpy ambient recovery; "
+       "measurement in docs/design.md)"
+       for name in ("igl_hhj.kernels.patch_recovery", "igl_hhj.kernels.tangent_projection6",
+                    "igl_hhj.kernels.smooth_vertex_tensors", "igl_hhj.recovery.recover_and_smooth",
+                    "igl_hhj.recovery.patch_recover", "igl_hhj.recovery.smooth_recovered")},
 }
 
 DOTTED = re.compile(r"igl_hhj(?:\.[A-Za-z_][A-Za-z0-9_]*)+")

@@ -34,33 +34,12 @@ def _vertex_stage_meshes():
     return out
 
 
-@pytest.mark.parametrize("name", ["closed", "open", "sliver", "unreferenced"])
-@pytest.mark.parametrize("smoothing", [0, 2, 5])
-def test_vertex_stage_equals_numpy_reference(name, smoothing):
-    """The compiled ambient patch recovery + smoothing (recovery.recover_and_smooth) equals
-    the numpy reference (recover_vertex_tensors + smooth_vertex_tensors), NaN rows included.
-    (The drop-in's intrinsic stage: tests/vertex_stage/test_intrinsic.py.)"""
-    from igl_hhj.curvature import _vertex_shape_operator_numpy, vertex_shape_operator
-    m = TriangleMesh(*_vertex_stage_meshes()[name])
-    S = _shape_operator(m, None, None, None, "direct")
-    Sv, N = vertex_shape_operator(m, S, smoothing=smoothing, recovery="patch")
-    Sr, Nr = _vertex_shape_operator_numpy(m, S, smoothing=smoothing)
-    ref = m.referenced_vertices
-    assert np.array_equal(np.isnan(Sv).any(axis=(1, 2)), ~ref)
-    assert np.array_equal(np.isnan(Sr).any(axis=(1, 2)), ~ref)
-    assert rel(Sv[ref], Sr[ref]) <= RTOL and np.array_equal(N, Nr, equal_nan=True)
-
-
 def test_recovery_kernels_equal_reference(closed):
     from igl_hhj import recovery as rc
     m = TriangleMesh(*sliver_mesh())
     for mesh in (closed, m):
         w = kernels.recovery_weights(mesh, rc.QUALITY_FLOOR)
         assert rel(w, rc.recovery_weights(mesh)) <= 1e-13
-        S = _shape_operator(mesh, None, None, None, "direct")
-        X = kernels.patch_recovery(mesh, S, mesh.vertex_normals, w)
-        Sv, _ = rc.recover_vertex_tensors(mesh, S, weights=w)
-        assert rel(rc._from6(X), Sv) <= 1e-13
     cross, dbl, l2max = kernels.face_metrics(closed.V, closed.F)
     ev = closed._edge_vectors
     np.testing.assert_allclose(cross, np.cross(ev[:, 2], -ev[:, 1]), rtol=0, atol=1e-15)
@@ -71,7 +50,7 @@ def test_recovery_kernels_equal_reference(closed):
 def test_patch_fit_of_vertices_whose_faces_all_weigh_zero(closed):
     """The compiled patch fit gathers each vertex's corners; a vertex whose corners all weigh 0
     falls back to the plain average of its faces (weight 1 each) there too: the compiled
-    recoveries equal the numpy references on a mesh with such vertices."""
+    recovery equals the numpy reference on a mesh with such vertices."""
     from igl_hhj import recovery as rc
     S = _shape_operator(closed, None, None, None, "direct")
     N = closed.vertex_normals
@@ -79,9 +58,6 @@ def test_patch_fit_of_vertices_whose_faces_all_weigh_zero(closed):
     lost = np.arange(0, closed.n_vertices, 37)
     w[np.isin(closed.F, lost).any(axis=1)] = 0.0
     assert (np.bincount(closed.F.ravel(), np.repeat(w, 3), closed.n_vertices)[lost] == 0).all()
-    X = kernels.patch_recovery(closed, S, N, w)
-    Sv, _ = rc.recover_vertex_tensors(closed, S, weights=w)
-    assert rel(rc._from6(X), Sv) <= 1e-13
     Xi, rough = kernels.intrinsic_patch_recovery(closed, S, N, w)
     assert rel(Xi, recover(closed, S, N, w)) <= 1e-13
     assert rel(rough, roughness(closed, S, N, Xi, w)) <= 1e-13
@@ -101,8 +77,7 @@ def test_gathered_vertex_kernels_bit_identical_across_thread_counts():
 
     def kernels_once():
         Xi, rough = kernels.intrinsic_patch_recovery(m, S, N, w)
-        return (kernels.patch_recovery(m, S, N, w), Xi, rough,
-                kernels.adaptive_radius(m, P, rough, 5.0, 0.3, 0.25, 0.2, 5.0))
+        return Xi, rough, kernels.adaptive_radius(m, P, rough, 5.0, 0.3, 0.25, 0.2, 5.0)
     for a, b in zip(*on_one_and_two_threads(kernels_once)):
         assert np.array_equal(a, b)
 
@@ -136,42 +111,45 @@ def test_smoothing_with_edges_out_of_lexicographic_order(closed):
 
 
 def test_smoothing_falls_back_to_the_reference_when_a_solve_stalls(closed, monkeypatch):
-    from igl_hhj import recovery as rc
+    """A compiled smoothing solve that stalls (status != 0) sends the vertex stage to the
+    sparse-LU smoothing (intrinsic_numpy.smooth_reference) from the recovered components:
+    the same values to the smoothing's tolerance."""
+    from igl_hhj import intrinsic
     S = _shape_operator(closed, None, None, None, "direct")
-    length = rc.smoothing_length(closed, 5)
-    good, _ = rc.recover_and_smooth(closed, S, length)
-    monkeypatch.setattr(kernels, "smooth_vertex_tensors", lambda *a, **k: (1, 500))
-    fallback, _ = rc.recover_and_smooth(closed, S, length)
-    assert rel(fallback, good) <= RTOL
+    good, _ = intrinsic.vertex_stage(closed, S, 5, rtol=1e-12)
+    monkeypatch.setattr(kernels, "intrinsic_smoothing", lambda *a, **k: (1, 500, 1, np.zeros(closed.n_faces)))
+    fallback, _ = intrinsic.vertex_stage(closed, S, 5, rtol=1e-12)
+    assert rel(fallback, good) <= 1e-5
 
 
 def test_stalled_smoothing_kernel_leaves_its_input_unchanged(closed):
     """The compiled smoothing returns a non-zero status without touching X when a solve
-    does not converge, so the fallback restarts from the recovered tensors (the drop-in
+    does not converge, so the fallback restarts from the recovered components (the drop-in
     has freed the face tensors by then)."""
+    from igl_hhj import intrinsic
     from igl_hhj import recovery as rc
     S = _shape_operator(closed, None, None, None, "direct")
-    X, N, w = rc.patch_recover(closed, S)
+    X, rough, N, w = intrinsic.vertex_recovery(closed, S)
     X0 = X.copy()
-    C, m = rc.smoothing_coefficients(closed, w)
-    t = rc.smoothing_length(closed, 5) ** 2 / 2
-    status, its = kernels.smooth_vertex_tensors(closed, X, C, m, t, 2, [2.0, -1.0], 1e-14, 2)
+    C0, m = rc.smoothing_coefficients(closed, w)
+    phase = kernels.transport_phases(closed, N)
+    status, *_ = intrinsic.adaptive_smoothing(closed, X, C0, m, phase, rough, 5, 1e-6, 2, solve_rtol=1e-14)
     assert status != 0 and np.array_equal(X, X0)
-    status, _ = kernels.smooth_vertex_tensors(closed, X, C, m, t, 2, [2.0, -1.0], 3e-3, 500)
+    status, *_ = intrinsic.adaptive_smoothing(closed, X, C0, m, phase, rough, 5, 1e-6)
     assert status == 0 and not np.array_equal(X, X0)
 
 
 def test_vertex_stage_bit_identical_across_thread_counts():
-    from igl_hhj import recovery as rc
+    from igl_hhj import intrinsic
     m = TriangleMesh(*bumpy(5))
     S = _shape_operator(m, None, None, None, "cg", 1e-10)
     nt = kernels.max_threads()
     adapt, kernels.ADAPT_TO_LOAD = kernels.ADAPT_TO_LOAD, False
     try:
         kernels.set_num_threads(1)
-        one, _ = rc.recover_and_smooth(m, S, rc.smoothing_length(m, 5))
+        one, _ = intrinsic.vertex_stage(m, S, 5)
         kernels.set_num_threads(max(2, nt))
-        two, _ = rc.recover_and_smooth(m, S, rc.smoothing_length(m, 5))
+        two, _ = intrinsic.vertex_stage(m, S, 5)
     finally:
         kernels.set_num_threads(nt)
         kernels.ADAPT_TO_LOAD = adapt
@@ -224,12 +202,14 @@ def test_smoothing_of_several_parts_bit_identical_across_thread_counts():
 
 def test_vertex_kernels_reject_bad_arrays(closed):
     S = np.zeros((closed.n_faces, 3, 3))
-    with pytest.raises(ValueError, match="patch_recovery"):
-        kernels.patch_recovery(closed, S[:-1], closed.vertex_normals, closed.face_areas)
+    with pytest.raises(ValueError, match="intrinsic_patch_recovery"):
+        kernels.intrinsic_patch_recovery(closed, S[:-1], closed.vertex_normals, closed.face_areas)
     X = np.zeros((closed.n_vertices, 5))
-    with pytest.raises(ValueError, match="smooth_vertex_tensors"):
-        kernels.smooth_vertex_tensors(closed, X, np.zeros((closed.n_faces, 3)),
-                                      np.ones(closed.n_vertices), 1.0, 2, [2, -1], 1e-3, 10)
+    with pytest.raises(ValueError, match="intrinsic_smoothing"):
+        kernels.intrinsic_smoothing(closed, X, np.zeros((closed.n_faces, 3)), np.ones(closed.n_vertices),
+                                    np.zeros((closed.n_edges, 2)), np.zeros(closed.n_vertices), 5,
+                                    per_radius=0.2, pilot_radius=5, pilot_rtol=1e-3, gain=0.3, power=0.25,
+                                    bounds=(0.2, 5.0), steps=2, coefficients=[2, -1], rtol=1e-3, maxiter=10)
 
 
 def test_dropin_frees_the_face_tensors_before_its_memory_peak(monkeypatch):
