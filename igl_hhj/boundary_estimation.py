@@ -1,6 +1,6 @@
 """Data-free boundary conditions for the HHJ shape operator: O(h²) boundary normals.
 
-Walker's clamped boundary condition (paper 000, eq. 5.19, the Σ_c term
+Walker's clamped boundary condition (Walker 2023, eq. 5.19, the Σ_c term
 ``∫_∂Γ n·ξ``) needs the true surface normal ν~ along the boundary; his
 Theorem 5.3 gives O(h) for S_h when ν~ is accurate to O(h²) (the nodal
 interpolant of the exact normal).  Without data, the *plain assembly* (face

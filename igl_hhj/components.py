@@ -1,5 +1,5 @@
 """Connected components: solve each one on its own, so that no component's result
-depends on another's (issue 23, "locality").
+depends on another's.
 
 The HHJ system of a mesh with several connected components is block diagonal, but
 an iterative solve of all blocks together shares its CG scalars and its stopping

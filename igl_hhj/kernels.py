@@ -307,7 +307,7 @@ def principal_2x2(S, N):
     """Closed-form principal curvatures/directions of tangential tensors.
 
     Reference: the numpy ``eigh`` version,
-    :func:`igl_hhj.curvature._principal_from_shape_operator_reference`.
+    ``principal_from_shape_operator_reference`` of ``tests/vertex_stage/reference_intrinsic.py``.
     ``S`` (n, 3, 3), ``N`` (n, 3) unit normals → ``PD1, PD2`` (n, 3), ``PV1 ≥ PV2`` (n,)."""
     S = _f64(S, "S", (3, 3))
     N = _f64(N, "N", (3,))
@@ -341,9 +341,9 @@ def _recovery_args(mesh, S, N, w, name):
 
 def intrinsic_patch_recovery(mesh, S, N, w):
     """Intrinsic patch recovery: ``(X, rough)``, X (#V, 3) components ``(h, Re z, Im z)``
-    (reference :func:`igl_hhj.intrinsic.recover`, rows of unreferenced vertices 0) and
+    (reference ``recover`` of ``tests/vertex_stage/reference_intrinsic.py``, rows of unreferenced vertices 0) and
     rough (#V,) the roughness of S_h around each vertex (reference
-    :func:`igl_hhj.intrinsic.roughness`).  ``S`` (#F, 3, 3), ``N`` (#V, 3) unit vertex
+    ``roughness`` there).  ``S`` (#F, 3, 3), ``N`` (#V, 3) unit vertex
     normals, ``w`` (#F,) face weights."""
     S, N, w = _recovery_args(mesh, S, N, w, "intrinsic_patch_recovery")
     _threads()
@@ -377,7 +377,7 @@ def graph_components(pairs, n):
 
 def dihedral_magnitudes(mesh):
     """``|θ_e|`` (#E,) of every edge with exactly two faces (0 on the others); reference
-    :func:`igl_hhj.features.dihedral_magnitudes_reference`."""
+    ``tests/vertex_stage/reference_creases.py``."""
     _threads()
     return _core.dihedral_magnitudes(_f64(mesh.face_normals, "face_normals", (3,)), _i32(mesh.edge_faces),
                                      _i8(mesh.edge_face_count))
@@ -397,7 +397,7 @@ def crease_cut(mesh, join):
 
 def transport_phases(mesh, N):
     """(#E, 2) cos and sin of the spin-2 transport of each edge; reference
-    :func:`igl_hhj.intrinsic.transport_phase_components`."""
+    :func:`igl_hhj.intrinsic_numpy.transport_phase_components`."""
     N = _f64(N, "N", (3,))
     if N.shape[0] != mesh.n_vertices:
         raise ValueError("transport_phases: N must be (#V, 3)")
@@ -423,7 +423,7 @@ def boundary_normal_fits(mesh, verts, rings, N0):
 
 
 def adaptive_radius(mesh, pilot, rough, radius, gain, power, lo, hi):
-    """Per-face smoothing radius (#F,); reference :func:`igl_hhj.intrinsic.adaptive_radius`."""
+    """Per-face smoothing radius (#F,); reference :func:`igl_hhj.intrinsic_numpy.adaptive_radius`."""
     pilot = _f64(pilot, "pilot", (3,))
     rough = _f64(rough, "rough")
     if pilot.shape[0] != mesh.n_vertices or rough.shape != (mesh.n_vertices,):
@@ -435,7 +435,8 @@ def adaptive_radius(mesh, pilot, rough, radius, gain, power, lo, hi):
 
 def principal_hz(X, N):
     """Principal directions and curvatures of components (h, Re z, Im z) (n, 3) in the frames
-    of N (n, 3): ``(PD1, PD2, PV1, PV2)``; reference :func:`igl_hhj.intrinsic.principal`."""
+    of N (n, 3): ``(PD1, PD2, PV1, PV2)``; reference ``principal`` of
+    ``tests/vertex_stage/reference_intrinsic.py``."""
     X = _f64(X, "X", (3,))
     N = _f64(N, "N", (3,))
     if X.shape[0] != N.shape[0]:
@@ -448,7 +449,7 @@ def intrinsic_smoothing(mesh, X, C, mass, phase, rough, radius, *, per_radius, p
                         gain, power, bounds, steps, coefficients, rtol, maxiter):
     """The drop-in's smoothing in one call, in place on ``X`` (#V, 3): the pilot step, the
     adaptive per-face radius, the twiced smoothing at it (reference
-    :func:`igl_hhj.intrinsic.vertex_stage_reference`).  Returns ``(status, iterations,
+    :func:`igl_hhj.intrinsic_numpy.smooth_reference`).  Returns ``(status, iterations,
     components, radius (#F,))``; status 0 when every solve converged (else X unchanged)."""
     if not (isinstance(X, np.ndarray) and X.dtype == np.float64 and X.flags.c_contiguous
             and X.shape == (mesh.n_vertices, 3)):

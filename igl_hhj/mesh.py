@@ -40,7 +40,7 @@ Numerical-robustness policy (one set of limits for every solver)
   they are listed in ``bad_vertices`` (:func:`mark_bad_vertices`).
 * :class:`TriangleMesh` holds read-only copies of ``V`` and ``F``: the arrays
   cannot change after validation.
-* The topology maps are narrow (memory at the solve, issue 25): edge, face and
+* The topology maps are narrow (the memory of the drop-in's solve): edge, face and
   vertex indices in them are int32 (``edges``, ``face_edges``, ``edge_faces``), local
   indices, signs and counts int8 (``edge_local_index``, ``face_edge_sign``,
   ``edge_face_count``).  Indexing, ``np.bincount`` and scipy.sparse take them as they

@@ -20,7 +20,7 @@ The public functions (:mod:`igl_hhj.curvature`, with the docstrings) call
 8. **principal values and NaN rows**: ``κ1,2 = H ± |z|`` and the directions, NaN rows at
    unreferenced vertices and vertices without a tangent plane.
 
-Each stage's comment in :func:`dropin_on_mesh` names the section of ``_core/small_mesh.cpp``
+Each stage's comment below names the section of ``_core/small_mesh.cpp``
 that does the same for a small mesh.
 """
 from __future__ import annotations
@@ -117,8 +117,8 @@ def principal_curvature(V, F, radius, useKring, opts: Options, *, repair_defects
     out = _small_mesh_path(V, F, radius, opts)                             # 2. small-mesh path
     if out is not None:
         return out
-    try:
-        mesh = as_mesh(V, F, copy=False)                                   # 3. mesh (views of V, F)
+    try:                                           # 3. mesh, views of V, F (small_mesh.cpp, "stage 3")
+        mesh = as_mesh(V, F, copy=False)
     except MeshDefectError as exc:                                         # 3. | repair
         if not repair_defects:
             raise
@@ -148,20 +148,20 @@ def dropin_on_mesh(mesh, radius, boundary, boundary_normals, boundary_shape_oper
 
     ``release``: the mesh's face cross products (24 B/face) are dropped before the solve, the
     call's memory peak (a mesh private to the call).  Returns ``(PD1, PD2, PV1, PV2, bad)``."""
-    # 5. boundary treatment (small_mesh.cpp: "boundary="estimate"")
+    # 5. boundary treatment (small_mesh.cpp, "stage 5, boundary treatment")
     boundary_normals, treatment = resolve_boundary(mesh, boundary, boundary_normals, boundary_shape_operator)
     rtol = check_rtol(rtol)
     if release:      # the vertex stage's normals now; the default path never reads the products again
         mesh.vertex_normals
         mesh.release_face_cross_products()
-    # 6. S_h per solve group (small_mesh.cpp: "HHJ system in the Morton numbering and its direct solve")
+    # 6. S_h per solve group (small_mesh.cpp, "stage 6, S_h": a small mesh is one direct solve)
     S = face_shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver, rtol,
                             estimated=treatment == "estimate", groups_of=groups_of)
-    # 7. vertex stage (small_mesh.cpp: "the vertex stage"): S is freed before the smoothing
+    # 7. vertex stage (small_mesh.cpp, "stage 7"): S is freed between recovery and smoothing
     X, rough, N, w = intrinsic.vertex_recovery(mesh, S)
     del S
     X = intrinsic.vertex_smoothing(mesh, X, N, w, rough, radius, rtol, by_parts=by_parts)
-    # 8. principal values (small_mesh.cpp: principal_hz) and NaN rows (small_mesh.cpp: "NaN rows")
+    # 8. principal values and NaN rows (small_mesh.cpp, "stage 8")
     PD1, PD2, PV1, PV2 = kernels.principal_hz(X, N)
     del X
     return _nan_rows(mesh, PD1, PD2, PV1, PV2)

@@ -196,7 +196,7 @@ def recovery_operator(mesh: TriangleMesh, method="patch", weights=None, normals=
     two faces) keep the lumped row.  Rows of unreferenced vertices are empty.
     ``weights`` may also be per corner, (#F, 3); ``corners=True`` returns the
     (#V × 3#F) matrix acting on per-corner values (row-major corners ``3 f + c``), as
-    :func:`igl_hhj.intrinsic.recover` needs.
+    the intrinsic recovery's numpy reference needs.
     """
     N = mesh.vertex_normals if normals is None else normals
     w = recovery_weights(mesh) if weights is None else np.asarray(weights, dtype=np.float64)

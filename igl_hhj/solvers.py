@@ -43,7 +43,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-try:  # imported here, not in the first solve (first call ≈ later calls, issue 16)
+try:  # imported here, not in the first solve (so that a first call costs as the later ones)
     from cholespy import CholeskySolverD, MatrixType
 except ImportError:  # pragma: no cover - cholespy is a dependency
     CholeskySolverD = MatrixType = None

@@ -6,7 +6,7 @@
 //   n_i = t_i x nu (outward conormal), grad lambda_i = -l_i n_i / (2|T|).
 // No hidden state: every kernel reads its inputs and writes caller-owned outputs.
 // Arrays are row-major (C-contiguous) float64 / int64; the topology maps of
-// mesh.TriangleMesh are narrow (memory, issue 25): edge, face and vertex indices in
+// mesh.TriangleMesh are narrow (memory): edge, face and vertex indices in
 // them int32 (i32), local indices, signs and incidence counts int8 (i8).  Load an
 // i32 into an i64 before multiplying it (3 * e overflows int above 715M).
 #pragma once
@@ -280,8 +280,9 @@ PCGResult block_pcg(i64 n, int k, const I* Ap, const std::int32_t* Ai, const dou
 int envelope_ldl_solve(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const double* Ax,
                        const double* R, double* X, double resid_rtol);
 
-// small_mesh.cpp: the drop-in on a small mesh in one call (issue 24, fixed cost).
-// The parameters are the Python constants of the general path (igl_hhj.small_mesh).
+// small_mesh.cpp: the drop-in on a small mesh in one call (the fixed cost per call).
+// The parameters are the Python constants of the general path (igl_hhj.constants, passed
+// by igl_hhj.small_mesh).
 struct SmallParams {
     double degenerate_rtol, min_mesh_size, folded_rtol, quality_floor, direct_rtol;
     i64 max_edges;            // the envelope solver's limit (solvers.ENVELOPE_MAX)

@@ -1,5 +1,5 @@
 """Heine's L2-projected Weingarten map on curved surfaces, Lagrange degree γ
-(paper 003, Def. 3.1 and 3.2).
+(Heine 2006, Def. 3.1 and 3.2).
 
 With W_h the continuous Lagrange space of degree γ on Γ^m (parametric: basis
 N_a ∘ X⁻¹ on every curved triangle) and ν_h the elementwise normal of Γ^m:

@@ -1,4 +1,4 @@
-"""Walker's HHJ shape operator on curved Lagrange surfaces (paper 000, §5, eq. 5.11–5.19).
+"""Walker's HHJ shape operator on curved Lagrange surfaces (Walker 2023, §5, eq. 5.11–5.19).
 
 For k = 1, 2, 3 the HHJ projection σ_h^k ∈ V_h^m (degree r = m − 1) of the
 surface Hessian of the coordinate function id^k ∈ W_h^m solves
