@@ -384,8 +384,8 @@ def dihedral_magnitudes(mesh):
 
 
 def crease_cut(mesh, join):
-    """The cut of :func:`igl_hhj.features.cut_along` (reference
-    :func:`igl_hhj.features.cut_along_reference`): ``join`` (#E,) bool, the edges across
+    """The cut of :func:`igl_hhj.creases.cut_along` (reference
+    :func:`igl_hhj.creases.cut_along_reference`): ``join`` (#E,) bool, the edges across
     which corners stay together (two faces, not a crease).  Returns ``(Fc (#F, 3) int64,
     extra (k,) int64)``: the cut faces and the vertex of every extra side (row #V + i)."""
     join = np.ascontiguousarray(join, dtype=np.uint8)

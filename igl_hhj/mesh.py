@@ -285,7 +285,7 @@ class TriangleMesh:
         """A mesh of the faces of ``mesh`` with new vertex indices ``F`` into ``V``, built
         without the checks (internal: the caller guarantees that every row of ``F`` has the
         positions of the same row of ``mesh.F`` and that the result is an oriented
-        edge-manifold mesh, as :func:`igl_hhj.features.cut_along` does).  The per-face
+        edge-manifold mesh, as :func:`igl_hhj.creases.cut_along` does).  The per-face
         metrics of ``mesh`` are reused: they depend only on the corner positions."""
         self = cls.__new__(cls)
         self._set_arrays(V, F, copy=True)

@@ -17,6 +17,7 @@ A module may import modules of its own layer or below; the import graph has no c
 from __future__ import annotations
 
 import ast
+import functools
 from pathlib import Path
 
 import pytest
@@ -149,6 +150,7 @@ def imports_of(module):
     return out
 
 
+@functools.cache
 def import_graph():
     """{importer: {imported: (line, lazy)}} over the package (the façade's own lazy
     imports are its purpose and are not edges)."""
@@ -245,3 +247,17 @@ def test_the_checker_sees_lazy_imports_and_cycles():
     assert _cycles({"a": {"b": (1, True)}, "b": {"a": (2, True)}}) == [["a", "b"]]
     assert _cycles({"a": {"b": (1, False)}, "b": {}}) == []
     assert layer_of("igl_hhj.regge.curvature") == "public" and layer_of("igl_hhj.viewer.x") == "app"
+
+
+def test_the_dropin_path_does_not_import_the_numpy_element():
+    """The drop-in's production path (its modules and everything they import) never loads
+    the numpy HHJ element igl_hhj.hhj (the readable reference; its clamped load and the
+    generic SPD solve live in igl_hhj.boundary and igl_hhj.solvers)."""
+    graph = import_graph()
+    seen, todo = set(), ["igl_hhj.pipeline"]
+    while todo:
+        m = todo.pop()
+        if m not in seen:
+            seen.add(m)
+            todo.extend(graph.get(m, ()))
+    assert "igl_hhj.hhj" not in seen and "igl_hhj.intrinsic" in seen, sorted(seen)
