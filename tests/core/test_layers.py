@@ -125,13 +125,9 @@ def imports_of(module):
     path = MODULES[module]
     tree = ast.parse(path.read_text(encoding="utf-8"))
     package = module if path.name == "__init__.py" else module.rpartition(".")[0]
-    lazy_nodes = set()
-    for node in ast.walk(tree):
-        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
-            lazy_nodes.update(id(n) for n in ast.walk(node))
     out = []
-    for node in ast.walk(tree):
-        lazy = id(node) in lazy_nodes
+
+    def visit(node, lazy):
         if isinstance(node, ast.Import):
             for a in node.names:
                 if a.name == "igl_hhj" or a.name.startswith("igl_hhj."):
@@ -139,14 +135,20 @@ def imports_of(module):
         elif isinstance(node, ast.ImportFrom):
             if node.level:
                 base = package.split(".")
-                base = base[:len(base) - (node.level - 1)]
-                base = ".".join(base + ([node.module] if node.module else []))
+                base = ".".join(base[:len(base) - (node.level - 1)] + ([node.module] if node.module else []))
             elif node.module and (node.module == "igl_hhj" or node.module.startswith("igl_hhj.")):
                 base = node.module
             else:
-                continue
-            for a in node.names:
-                out.append((_target(base, a.name), node.lineno, lazy))
+                return
+            out.extend((_target(base, a.name), node.lineno, lazy) for a in node.names)
+        elif isinstance(node, (ast.expr, ast.Pass, ast.Break, ast.Continue)):
+            return                      # no statement (hence no import) below an expression
+        else:
+            lazy = lazy or isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda))
+            for child in ast.iter_child_nodes(node):
+                visit(child, lazy)
+
+    visit(tree, False)
     return out
 
 
