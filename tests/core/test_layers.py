@@ -58,6 +58,10 @@ MODULE_LAYER = {
     "igl_hhj.convergence": "public",
     "igl_hhj.surfaces": "public",
     "igl_hhj.interop": "io",
+    # the application half's new shared modules (branch house-app): the result type that I/O
+    # and the baselines share, and the captured output of the readers
+    "igl_hhj.results": "public",
+    "igl_hhj.capture": "io",
     "igl_hhj.mesh_io": "io",
     "igl_hhj.polygon_io": "io",
     "igl_hhj.vtk_files": "io",
@@ -67,6 +71,7 @@ MODULE_LAYER = {
     "igl_hhj.cli": "app",
     "igl_hhj.demos": "app",
     "igl_hhj.benchmarks": "app",
+    "igl_hhj.docs": "app",             # the Sphinx configuration (igl_hhj/docs/conf.py)
     # the package itself: its __getattr__ imports any submodule on first use, so importing
     # it (``import igl_hhj``) stands for the whole package: an application-layer import
     "igl_hhj": "app",
@@ -103,7 +108,10 @@ MODULES = _modules()
 
 
 def layer_of(name):
-    best = max((k for k in MODULE_LAYER if name == k or name.startswith(k + ".")), key=len, default=None)
+    """The layer of module ``name``: its own entry or its package's (the longest prefix;
+    the package root ``igl_hhj`` covers only itself)."""
+    best = max((k for k in MODULE_LAYER if name == k or (k != "igl_hhj" and name.startswith(k + "."))),
+               key=len, default=None)
     return None if best is None else MODULE_LAYER[best]
 
 
@@ -249,6 +257,7 @@ def test_the_checker_sees_lazy_imports_and_cycles():
     assert _cycles({"a": {"b": (1, True)}, "b": {"a": (2, True)}}) == [["a", "b"]]
     assert _cycles({"a": {"b": (1, False)}, "b": {}}) == []
     assert layer_of("igl_hhj.regge.curvature") == "public" and layer_of("igl_hhj.viewer.x") == "app"
+    assert layer_of("igl_hhj.no_such_module") is None         # a new module must be placed
 
 
 def test_the_dropin_path_does_not_import_the_numpy_element():
