@@ -186,36 +186,36 @@ def test_user_script_sees_the_real_types(tmp_path):
 
 
 def test_decorated_functions_keep_their_signature():
-    """``kernels.with_large_call_heap`` is ``Callable[P, R] -> Callable[P, R]`` and keeps
+    """``runtime.with_large_call_heap`` is ``Callable[P, R] -> Callable[P, R]`` and keeps
     the run-time signature too (``inspect`` follows ``__wrapped__``); V and F reach the
     heap scope positionally or by keyword."""
     import inspect
 
     import igl_hhj
-    from igl_hhj import kernels
+    from igl_hhj import runtime
     from igl_hhj.surfaces import icosphere
     sig = inspect.signature(igl_hhj.principal_curvature)
     assert list(sig.parameters)[:4] == ["V", "F", "radius", "useKring"]
-    hints = kernels.with_large_call_heap.__annotations__
+    hints = runtime.with_large_call_heap.__annotations__
     assert str(hints["fn"]).startswith("Callable[_P, _R]") and str(hints["return"]).startswith("Callable[_P, _R]")
     seen = []
 
     def probe(V, F=None, *, k=1):
         return V, F, k
-    wrapped = kernels.with_large_call_heap(probe)
-    original = kernels.large_call_heap
+    wrapped = runtime.with_large_call_heap(probe)
+    original = runtime.large_call_heap
 
     def spy(n):
         seen.append(n)
         return original(n)
-    kernels.large_call_heap = spy
+    runtime.large_call_heap = spy
     try:
         V, F = icosphere(1)
         assert wrapped(V, F, k=2) == (V, F, 2)
         assert wrapped(V=V, F=F) == (V, F, 1)
         assert wrapped(V) == (V, None, 1)
     finally:
-        kernels.large_call_heap = original
+        runtime.large_call_heap = original
     assert seen == [len(F), len(F), 0]
 
 
