@@ -545,10 +545,10 @@ def test_pending_options_entry_dates_the_output(tmp_path):
     out.write_bytes(b"x")
     key = batch.options_key("igl", "vertex", None)
     mtime = os.stat(out).st_mtime_ns
-    assert batch._made_with({"options": key, "done": False, "t": mtime - 1}, str(out)) == key
-    assert batch._made_with({"options": key, "done": False, "t": mtime + 1}, str(out)) is None
-    assert batch._made_with({"options": key, "done": True, "t": mtime + 1}, str(out)) == key
-    assert batch._made_with(None, str(out)) is None and batch._made_with("junk", str(out)) is None
+    assert batch.resume._made_with({"options": key, "done": False, "t": mtime - 1}, str(out)) == key
+    assert batch.resume._made_with({"options": key, "done": False, "t": mtime + 1}, str(out)) is None
+    assert batch.resume._made_with({"options": key, "done": True, "t": mtime + 1}, str(out)) == key
+    assert batch.resume._made_with(None, str(out)) is None and batch.resume._made_with("junk", str(out)) is None
 
 
 # --------------------------------------------------------------------------- warnings (issue 26)
