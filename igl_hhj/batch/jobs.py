@@ -16,6 +16,7 @@ from ..errors import MeshFileError
 from ..results import QUANTITIES
 from .compute import compute_curvature
 
+
 PERCENTILES = (1, 50, 99)
 SUMMARY_COLUMNS = (["path", "output", "status", "vertices", "faces", "seconds", "cpu_seconds",
                     "peak_memory", "error", "warnings"]

@@ -9,6 +9,7 @@ from pathlib import Path
 from ..mesh_io import MESH_EXTENSIONS
 from .jobs import TMP_MARK, Job
 
+
 FORMATS = ("npz", "ply", "vtp", "vtu")
 """Output formats of ``igl-hhj batch`` (as ``igl-hhj curvature -o``)."""
 GROUP_BYTES = 400_000

@@ -13,6 +13,7 @@ from ..results import CurvatureEstimate
 from .compute import default_radius
 from .jobs import SUMMARY_COLUMNS, TMP_MARK, _percentile_stats, _row
 
+
 OPTIONS_FILE = ".igl-hhj-options.json"
 """``OUTDIR/OPTIONS_FILE``: ``{output relative to OUTDIR: {"options": {method, per, radius},
 "done": bool, "t": ns}}``.  ``done`` False: the output was being recomputed with ``options``

@@ -16,6 +16,7 @@ from .resume import (_made_with, _previous_rows, _read_options_file, _skipped_ro
 from .sandbox import _local, run_group
 from .summary import _Progress, write_summary
 
+
 IN_PROCESS_MAX_FILES = 4
 """Without a scheduler, at most this many files run in-process (no cluster start-up)."""
 MAX_WORKERS = 256

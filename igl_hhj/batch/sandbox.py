@@ -9,6 +9,7 @@ import time
 
 from .jobs import _proc_status_bytes, _row, process_mesh
 
+
 class _Sandbox:
     """A persistent child process computing one mesh at a time, killed on timeout / memory.
 

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from .jobs import SUMMARY_COLUMNS, TMP_MARK
 
+
 def _fmt(v):
     if v is None:
         return ""

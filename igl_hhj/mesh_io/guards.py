@@ -14,6 +14,7 @@ from ..polygon_io import EXTRA_EXTENSIONS
 from .extensions import MESH_EXTENSIONS, READ_EXTENSIONS
 from .scan import _Lines, _check_rows, _first_bad, _line_tokens, _too_short
 
+
 _HEADER_BYTES = 1 << 16
 """The first bytes of a file read to tell its kind and check its header."""
 

@@ -12,6 +12,7 @@ import numpy as np
 from ..errors import MeshFileError
 from .scan import _Lines, _check_rows, _first_bad, _too_short
 
+
 _PLY_HEADER_MAX = 1 << 26           # a PLY header may be long (comments), not unbounded
 _PLY_SIZES = {"char": 1, "int8": 1, "uchar": 1, "uint8": 1, "short": 2, "int16": 2,
               "ushort": 2, "uint16": 2, "int": 4, "int32": 4, "uint": 4, "uint32": 4,

@@ -16,6 +16,7 @@ from .guards import _check_input_file, _check_keyword_counts, _check_obj, _check
 from .ply import _PLY_SIZES, _check_ply, _parse_ply_header, _ply_scalar
 from .scan import _Lines
 
+
 def _libigl_says(lines):
     if not lines:
         return ""

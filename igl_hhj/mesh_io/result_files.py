@@ -16,6 +16,7 @@ from .guards import _HEADER_BYTES, _check_input_file_any
 from .ply import _parse_ply_header, _ply_head, _ply_scalar
 from .readers import read_mesh_file
 
+
 _METHOD_NAMES = {"hhj": "hhj", "igl": "libigl_quadric", "heine": "heine"}
 
 

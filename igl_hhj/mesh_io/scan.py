@@ -9,6 +9,7 @@ import numpy as np
 
 from ..errors import MeshFileError
 
+
 def _too_short(path, what, need, have):
     raise MeshFileError(f"{path}: truncated or corrupt: the header declares {what}, which needs "
                         f"at least {need} bytes after the header, but the file has {have}")

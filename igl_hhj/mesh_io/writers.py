@@ -12,6 +12,7 @@ from ..errors import MeshFileError
 from ..results import QUANTITIES
 from .extensions import OUTPUT_EXTENSIONS, VTK_EXTENSIONS
 
+
 CURVATURE_COLUMNS = ("k1", "k2", "H", "K", "d1x", "d1y", "d1z", "d2x", "d2y", "d2z")
 """Per-element columns of the ``.csv`` and ``.ply`` outputs (after ``index`` in the csv)."""
 

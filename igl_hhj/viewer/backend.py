@@ -12,6 +12,7 @@ import numpy as np
 
 from .camera import _frame, _union_bounds
 
+
 _EGL_HINT = ("headless rendering needs EGL: on Debian/Ubuntu `apt-get install libegl1 libegl-mesa0 "
              "libgl1-mesa-dri`")
 _REGISTERED: dict[str, np.ndarray] = {}  # name -> (2, 3) bounds of the structures this module registered (they may since be removed)

@@ -6,6 +6,7 @@ import numpy as np
 
 from .values import _check
 
+
 VIEWS = ("auto", "+x", "-x", "+y", "-y", "+z", "-z")
 """Named ``view=`` directions (the side the camera looks from); a 3-vector works too."""
 

@@ -15,6 +15,7 @@ from .render import _check_screenshot
 from .structures import _add_estimate, _finish, _surface, _title
 from .values import _TAG, METHOD_TITLES, METHODS, QUANTITIES, _check, _explicit_range, color_range
 
+
 def curvature_estimate(V: Any, F: Any = None, *, method="hhj", per="face", **kwargs) -> Any:
     """Curvatures of one estimator as a :class:`igl_hhj.baselines.CurvatureEstimate`.
 

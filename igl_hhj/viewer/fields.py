@@ -13,6 +13,7 @@ from .render import _check_screenshot
 from .structures import _finish, _line_field, _placed, _record_bounds, _scalar, _surface, _title
 from .values import LONG_LABELS, _check, _explicit_range, color_range, local_edge_length
 
+
 def register_hessian(V, F, w, *, boundary_gradient=None, name="mesh", label="w", enabled="trace",
                      directions=True, symmetric=True, robust=None, cmap="coolwarm", direction_scale=0.5,
                      offset=None, view=None, title=None, screenshot=None, size=(1024, 768)) -> Registration:

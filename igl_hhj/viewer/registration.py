@@ -13,6 +13,7 @@ from .backend import _REGISTERED, _backend_name
 from .camera import _union_bounds
 from .render import _png_bytes, _render
 
+
 @dataclass(frozen=True)
 class QuantityInfo:
     """One registered polyscope quantity.

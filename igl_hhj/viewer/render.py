@@ -9,6 +9,7 @@ import numpy as np
 from .backend import _REGISTERED, ViewerUnavailable, _add_scalar, _backend_name
 from .camera import _frame
 
+
 def _check_screenshot(path, size):
     """Fail fast (before any computation) on an unwritable PNG path or a bad size."""
     if path is None:

@@ -10,6 +10,7 @@ from .registration import QuantityInfo
 from .render import _render
 from .values import LABELS, LONG_LABELS, QUANTITIES, local_edge_length
 
+
 def _placed(reg, name, V, F, offset=None, view=None):
     """The displayed positions of the mesh (V, F) registered as ``name``: turned by ``view``
     (the rotation recorded in ``reg.rotations``) and translated by ``offset``."""

@@ -6,6 +6,7 @@ import numpy as np
 
 from ..results import QUANTITIES  # noqa: F401  (the quantities the curvature pictures show)
 
+
 METHODS = ("hhj", "igl", "heine")
 LABELS = {"k1": "kappa1", "k2": "kappa2", "H": "mean H", "K": "Gauss K"}
 LENGTH_UNIT = "1/length unit"
