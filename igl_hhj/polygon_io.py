@@ -224,7 +224,7 @@ def read_polygon_mesh(path: str | os.PathLike, readers: tuple[str, ...] | None =
     ------
     ModuleNotFoundError
         None of the packages is installed (the message names the install command).
-    igl_hhj.mesh_io.MeshFileError
+    igl_hhj.errors.MeshFileError (also igl_hhj.mesh_io.MeshFileError)
         The package could not read the file, or it holds no surface cells.
     """
     path = Path(path)

@@ -477,7 +477,7 @@ def _wait_for_library(pid, name, timeout=60):
 @pytest.mark.skipif(not LINUX, reason="POSIX signals, /proc")
 @pytest.mark.parametrize("library", ["_multiarray_umath", "_sparsetools", "pyigl_core"])
 def test_ctrl_c_during_imports_is_one_line(sphere_off, library):
-    """SIGINT while the igl-hhj command is importing numpy (module level of cli.py),
+    """SIGINT while the igl-hhj command is importing numpy (module level of the igl_hhj.cli package),
     scipy.sparse or libigl (inside main): one line, exit 130, no traceback."""
     import shutil
     from pathlib import Path
