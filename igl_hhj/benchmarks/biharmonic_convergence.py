@@ -19,7 +19,7 @@ hemisphere meshes up to ``--perf-max-vertices``, in the same run for
 (c) a plain direct sparse solve of the lumped ``K M⁻¹ K`` system
     (``scipy.sparse.linalg.spsolve``, SuperLU with its default ordering),
 (e) one sparse Cholesky factorisation (CHOLMOD via cholespy) of that lumped
-    ``K M⁻¹ K`` system alone, the yardstick of the full-mass method (issue 16:
+    ``K M⁻¹ K`` system alone, the yardstick of the full-mass method (target:
     within 2×; the ratio is printed),
 (d) ``igl.harmonic(V, F, b, g, k=2)`` against ``biharmonic_solve(..., f=0,
     mass="voronoi", g=g)`` (the same discrete problem; max difference reported).

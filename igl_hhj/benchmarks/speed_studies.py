@@ -281,7 +281,7 @@ def _interleaved_ms(fns, calls, warmup, clock):
 
 
 def tiny_study(calls=400):
-    """Fixed cost per call on meshes under 1,000 faces (issue 24: ≤ 2× libigl's time).
+    """Fixed cost per call on meshes under 1,000 faces (target: ≤ 2× libigl's time).
 
     Each mesh: the median over ``calls`` interleaved calls of ``igl.principal_curvature``
     and of the drop-in (radius 5, warm: the first calls are dropped).  Returns rows
@@ -310,7 +310,7 @@ FEATURE_MESHES = ("fandisk.off", "screwdriver.off")
 
 
 def feature_study(mesh_dir=None, calls=15, feature_angle=40):
-    """Cost of sharp-feature handling (issue 27: ≤ 1.3× the drop-in without it).
+    """Cost of sharp-feature handling (target: ≤ 1.3× the drop-in without it).
 
     For each of :data:`FEATURE_MESHES` found in ``mesh_dir`` (default ../shared/data/meshes):
     the median CPU time (``time.process_time``, one thread) over ``calls`` interleaved

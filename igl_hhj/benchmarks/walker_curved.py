@@ -1,4 +1,4 @@
-"""Walker's curved blocks (paper 000, §6, Tables 1–5, m = 2, 3): geometry of degree m,
+"""Walker's curved blocks (Walker 2023, §6, Tables 1–5, m = 2, 3): geometry of degree m,
 HHJ of degree r = m − 1, on the project's four surfaces.
 
 Used by ``python -m igl_hhj.benchmarks.walker_tables --orders 1 2 3``.  For each

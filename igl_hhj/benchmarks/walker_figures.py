@@ -1,4 +1,4 @@
-"""Walker's Figs. 3–6 (paper 000, §6): the four test surfaces at m = 1, k = 1, coloured by
+"""Walker's Figs. 3–6 (Walker 2023, §6): the four test surfaces at m = 1, k = 1, coloured by
 the discrete Gauss curvature κ_h^g = det(S_h + ν⊗ν) (eq. 6.1), and a zoom with the
 principal directions as line segments — red d_1 (minimum curvature), black d_2
 (maximum), as in the paper's captions.
