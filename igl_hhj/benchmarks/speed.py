@@ -40,8 +40,10 @@ import numpy as np
 
 from . import progress as progress_bar
 from .speed_meshes import _best, _build, _default_mesh_dir, min_angle_degrees
-from .speed_studies import (factor_markdown, factor_study, feature_markdown, feature_study, profile_stages,
-                            rtol_markdown, rtol_study, sliver_study, tiny_markdown, tiny_study)
+from .speed_studies import (FACTOR_MESHES, FEATURE_MESHES, RTOLS, SLIVER_ANGLES, SLIVER_MESHES,  # noqa: F401
+                            copy_bandwidth, factor_markdown, factor_study, feature_markdown, feature_study,
+                            profile_stages, rtol_markdown, rtol_study, sliver_study, tiny_markdown, tiny_meshes,
+                            tiny_study)
 
 
 # the direct column is skipped above this many faces (fill, minutes of factorisation)
