@@ -29,6 +29,8 @@ REMOVED = {
        "tests/vertex_stage/reference_intrinsic.py (igl_hhj.intrinsic is the compiled vertex stage)"
        for n in ("corner_components", "recover", "roughness", "principal", "vertex_stage_reference")},
     "igl_hhj.recovery.vertex_confidence": "dead code: no caller",
+    "igl_hhj.curved.display.show_field": "moved to igl_hhj.viewer.show_curved_field (the curved layer "
+       "no longer imports the viewer; docs/changelog.md)",
     "igl_hhj.kernels.lumped_vertex_recovery": "dead code: one test called it (its C++ went with it)",
     **{name: "the compiled twin of the ambient recovery, which only the non-default comparison option "
        "vertex_shape_operator(recovery='patch') used (now served by the numpy ambient recovery; "
