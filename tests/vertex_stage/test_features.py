@@ -459,7 +459,7 @@ def test_side_tolerance_in_the_units_of_the_part(monkeypatch):
     curvature) take one CG iteration per solve instead of converging relative to their own
     round-off, the curved side's solves are unchanged, and every value stays within the
     smoothing tolerance (1e-3) of the part's RMS of the unscaled solves."""
-    from igl_hhj import kernels
+    from igl_hhj import kernels, runtime
     from igl_hhj.recovery import QUALITY_FLOOR, smoothing_coefficients
     V, F, _ = capped_cylinder(3)
     mesh = as_mesh(V, F)
@@ -479,7 +479,7 @@ def test_side_tolerance_in_the_units_of_the_part(monkeypatch):
         calls.append((sub.n_vertices, out[1]))
         return out
     monkeypatch.setattr(kernels, "intrinsic_smoothing", counted)
-    monkeypatch.setattr(kernels, "task_workers", lambda: 1)     # the calls in part order
+    monkeypatch.setattr(runtime, "task_workers", lambda: 1)     # the calls in part order (run_tasks's policy)
     own, scaled = X.copy(), X.copy()
     intrinsic.adaptive_smoothing_by_parts(cm, own, *args)
     plain_calls, calls[:] = list(calls), []
