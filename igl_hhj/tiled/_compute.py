@@ -1,0 +1,104 @@
+"""The computation of one grown tile: the drop-in, keeping the scale its vertex stage chose.
+
+:func:`tile_values` is the one place where a tile is computed; it takes a ``params``
+dict so that a second pass (global parameters reduced from a first pass over the
+cores) only adds keys.  It runs the steps of :func:`igl_hhj.curvature.dropin_on_mesh`
+and :func:`igl_hhj.intrinsic.vertex_stage` on the tile and returns, with the values,
+the per-face smoothing radius r_T the stage used: the overlap rule
+(:mod:`igl_hhj.tiled.reach`) needs it, and the drop-in reports only its median.  The
+tests compare the tiled values with :func:`igl_hhj.principal_curvature` on the whole
+mesh, so a change of the drop-in that these steps miss fails them.
+"""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+
+__all__ = ["tile_values", "PARAM_KEYS"]
+
+PARAM_KEYS = ("radius", "rtol", "solver", "boundary")
+"""Keys of ``params`` read by :func:`tile_values` (as :func:`igl_hhj.principal_curvature`)."""
+
+
+def _vertex_stage(mesh, S, radius, rtol):
+    """:func:`igl_hhj.intrinsic.vertex_stage` (one smoothing call for the mesh) returning
+    the per-face radius too: ``(X, N, r (#F,))``."""
+    from .. import intrinsic, kernels
+    from ..recovery import QUALITY_FLOOR, smoothing_coefficients
+    N = mesh.vertex_normals
+    w = kernels.recovery_weights(mesh, QUALITY_FLOOR)
+    X, rough = kernels.intrinsic_patch_recovery(mesh, S.pop(), N, w)
+    C0, m = smoothing_coefficients(mesh, w)
+    phase = kernels.transport_phases(mesh, N)
+    status, _, _, r = intrinsic.adaptive_smoothing(mesh, X, C0, m, phase, rough, radius, rtol)
+    if status != 0:          # a solve stalled: the direct reference, as the drop-in
+        X = intrinsic._smooth_reference(mesh, X, N, w, rough, radius)
+    return X, N, r
+
+
+def _on_mesh(mesh, params):
+    """The drop-in on a validated mesh: ``(PD1, PD2, PV1, PV2, bad list, r (#F,))``."""
+    from .. import kernels
+    from ..curvature import _check_rtol, _resolve_boundary, _shape_operator
+    from ..mesh import mark_bad_vertices
+    rtol = _check_rtol(params["rtol"])
+    normals, treatment = _resolve_boundary(mesh, params["boundary"], None, None)
+    mesh.vertex_normals                      # then release the cross products (the peak)
+    mesh.__dict__.pop("_cross", None)
+    holder = [_shape_operator(mesh, normals, None, None, params["solver"], rtol,
+                              estimated=treatment == "estimate")]
+    X, N, r = _vertex_stage(mesh, holder, params["radius"], rtol)
+    PD1, PD2, PV1, PV2 = kernels.principal_hz(X, N)
+    del X
+    ref = mesh.referenced_vertices
+    if not ref.all():
+        for A in (PD1, PD2, PV1, PV2):
+            A[~ref] = np.nan
+    return (*mark_bad_vertices(mesh, PD1, PD2, PV1, PV2, copy=False), r)
+
+
+def tile_values(V, F, params):
+    """The drop-in's values on one grown tile and the scale its vertex stage used.
+
+    Parameters
+    ----------
+    V : (#V, 3) float64, F : (#F, 3) int64
+        The grown tile, numbered on its own.
+    params : dict
+        ``radius``, ``rtol``, ``solver``, ``boundary`` as :func:`igl_hhj.principal_curvature`.
+
+    Returns
+    -------
+    dict
+        ``PD1, PD2`` (#V, 3), ``PV1, PV2`` (#V,) float64 (NaN rows: the drop-in's
+        ``bad_vertices`` of the tile); ``radius`` (#F,) the vertex stage's per-face
+        smoothing radius r_T (on a repaired tile: its largest value on every face);
+        ``warnings``: the messages of the warnings the computation raised (a repair's
+        :class:`igl_hhj.mesh.MeshWarning`), in order, without duplicates.
+    """
+    from .. import kernels
+    from ..mesh import MeshDefectError, as_mesh
+    from ..repair import repaired_principal_curvature
+    radius_of = []
+
+    def on_arrays(V2, F2, radius, useKring, **_):
+        out = _on_mesh(as_mesh(V2, F2, copy=False), params)
+        radius_of.append(out[-1])
+        return out[:-1]
+
+    with warnings.catch_warnings(record=True) as caught, kernels.large_call_heap(len(F)):
+        warnings.simplefilter("always")
+        try:
+            mesh = as_mesh(V, F, copy=False)
+        except MeshDefectError as exc:         # repairable: as the drop-in (issue 24)
+            kw = dict(boundary=params["boundary"], solver=params["solver"], rtol=params["rtol"])
+            PD1, PD2, PV1, PV2, _ = repaired_principal_curvature(
+                on_arrays, exc, V, F, params["radius"], True, kw)
+            rmax = float(np.max(radius_of[0])) if radius_of and len(radius_of[0]) else 0.0
+            r = np.full(len(F), rmax)
+        else:
+            PD1, PD2, PV1, PV2, _, r = _on_mesh(mesh, params)
+    messages = list(dict.fromkeys(str(w.message) for w in caught))
+    return dict(PD1=PD1, PD2=PD2, PV1=PV1, PV2=PV2, radius=np.asarray(r, dtype=np.float64),
+                warnings=messages)

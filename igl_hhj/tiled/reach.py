@@ -1,0 +1,123 @@
+"""How far the drop-in's value at a vertex depends on the mesh: the overlap rule.
+
+A tile grown by ``k`` vertex rings around its core has a cut at ``k`` rings from
+every core vertex (:mod:`igl_hhj.tiled.rings`); the drop-in treats the cut as an
+open boundary, and the values in the core feel it through two chains of solves:
+
+* **the HHJ solve.**  Walker's S_h is the solution of a mass-matrix system (one
+  unknown per edge, coupled through faces); the inverse of such a matrix decays
+  exponentially with the graph distance.  The change of S_h caused by the cut,
+  relative to the largest |S_h|, falls by at least :data:`HHJ_DECADES_PER_RING`
+  decades per ring (measured: ``python -m igl_hhj.benchmarks.tiled --decay``), so
+  after ``k_S = ⌈log10(1/ε) / HHJ_DECADES_PER_RING⌉`` rings it is below ε.
+* **the vertex stage's smoothing.**  ``steps × order`` implicit diffusion solves
+  ``(M + t L)⁻¹ M`` with ``t = ℓ_T² / steps``, ``ℓ_T = SMOOTHING_PER_RADIUS · r_T · h_T``
+  (:mod:`igl_hhj.intrinsic`; ``r_T`` the per-face radius the stage chooses).  Across
+  a cut (a line source) each solve is the 1-D resolvent, whose Green's function is
+  ``e^{-|x|/a} / 2a`` with ``a = √t``; the composition of ``n`` of them decays like
+  the tail of a Gamma(n) law, ``Q_n(x/a) = e^{-x/a} Σ_{j<n} (x/a)^j / j!``, for a unit
+  perturbation at the cut.  The cut is therefore harmless below ε after a distance
+  ``x_n(ε) · a``, ``Q_n(x_n(ε)) = ε``; in rings, with :data:`RING_SPACING` mean edge
+  lengths per ring, ``k_L = ⌈x_n(ε) · SMOOTHING_PER_RADIUS · r_max · b / (√steps ·
+  RING_SPACING)⌉`` with ``r_max`` the largest radius on the faces between the cut and
+  the core and ``b`` :data:`igl_hhj.recovery.BOUNDARY_LENGTH_FACTOR` when those faces
+  touch a real open boundary (the stage smooths twice as far along it), 1 otherwise.
+
+The rule is ``k = k_S + k_L`` (:func:`overlap_rings`).  Both terms bound a unit
+perturbation at the cut; the values at the cut change by less than max |κ| (measured
+0.1–0.9 of it), so the rule is conservative there.  Its inputs follow the stage: the
+constants are read from :mod:`igl_hhj.intrinsic` and :mod:`igl_hhj.recovery`, and the
+radius is the one the stage reports for each tile (:func:`igl_hhj.tiled.runner`
+regrows a tile whose reported radius needs more rings than it was given).
+"""
+from __future__ import annotations
+
+import math
+
+__all__ = ["overlap_rings", "radius_bound", "hhj_rings", "smoothing_rings", "gamma_tail_root",
+           "HHJ_DECADES_PER_RING", "RING_SPACING", "DEFAULT_TOLERANCE"]
+
+DEFAULT_TOLERANCE = 1e-6
+"""Default ε: the cut changes a core value by at most ε · max |κ| (solver tolerances aside)."""
+
+HHJ_DECADES_PER_RING = 0.4
+"""Slowest measured decay of the cut's effect on S_h, in decades per vertex ring (direct
+solves, half-space cuts; ``python -m igl_hhj.benchmarks.tiled --decay``): 0.86–0.89 on
+jittered and noisy ellipsoids, 0.5–1.4 on real meshes, 0.40 on ``beetle.off`` (a scan
+with slivers, the slowest of the 15 measured)."""
+
+RING_SPACING = math.sqrt(3.0) / 2.0
+"""Distance gained per vertex ring, in mean edge lengths: the row height of a
+regular triangulation (a ring across a straight cut advances by ``√3/2 h`` in the
+worst direction, by ``h`` in the best)."""
+
+
+def gamma_tail_root(n: int, eps: float) -> float:
+    """``x`` with ``Q_n(x) = e^{-x} Σ_{j<n} x^j / j! = eps`` (bisection; Q_n decreases from 1)."""
+    if not 0.0 < eps < 1.0:
+        raise ValueError(f"tolerance must be in (0, 1), got {eps}")
+
+    def q(x):
+        term, total = 1.0, 1.0
+        for j in range(1, n):
+            term *= x / j
+            total += term
+        return math.exp(-x) * total
+
+    lo, hi = 0.0, 1.0
+    while q(hi) > eps:
+        lo, hi = hi, 2.0 * hi
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if q(mid) > eps else (lo, mid)
+    return hi
+
+
+def hhj_rings(eps: float = DEFAULT_TOLERANCE) -> int:
+    """Rings after which the cut changes S_h by less than ``eps`` (relative)."""
+    return math.ceil(math.log10(1.0 / eps) / HHJ_DECADES_PER_RING)
+
+
+def smoothing_rings(radius: float, eps: float = DEFAULT_TOLERANCE, *, boundary: bool = False) -> int:
+    """Rings after which the cut changes the smoothed values by less than ``eps``.
+
+    ``radius``: the largest per-face radius r_T of the vertex stage between the cut and
+    the core (0: no smoothing); ``boundary``: those faces touch a real open boundary."""
+    from ..intrinsic import SMOOTHING_ORDER, SMOOTHING_STEPS
+    from ..recovery import BOUNDARY_LENGTH_FACTOR, SMOOTHING_PER_RADIUS
+    if not radius > 0:
+        return 0
+    n = SMOOTHING_STEPS * SMOOTHING_ORDER
+    a = SMOOTHING_PER_RADIUS * float(radius) / math.sqrt(SMOOTHING_STEPS)   # √t in mean edge lengths
+    if boundary:
+        a *= BOUNDARY_LENGTH_FACTOR
+    return math.ceil(gamma_tail_root(n, eps) * a / RING_SPACING)
+
+
+def overlap_rings(radius: float, eps: float = DEFAULT_TOLERANCE, *, boundary: bool = False) -> int:
+    """The overlap rule ``k = k_S + k_L`` (module docstring): rings of overlap after which
+    the cut changes a core value by less than ``eps`` times max |κ|.
+
+    Parameters
+    ----------
+    radius : float
+        Largest smoothing radius r_T (in rings, the vertex stage's per-face radius) on
+        the faces between the cut and the core.
+    eps : float, default :data:`DEFAULT_TOLERANCE`
+    boundary : bool
+        Those faces touch a real open boundary of the mesh.
+
+    Examples
+    --------
+    >>> from igl_hhj.tiled.reach import overlap_rings
+    >>> overlap_rings(1.0), overlap_rings(5.0), overlap_rings(25.0)
+    (19, 33, 103)
+    """
+    return hhj_rings(eps) + smoothing_rings(radius, eps, boundary=boundary)
+
+
+def radius_bound(radius: float) -> float:
+    """The largest per-face radius the vertex stage can choose at the caller's ``radius``
+    (``radius × ADAPTIVE_RANGE[1]``: 25 rings at the default 5)."""
+    from ..intrinsic import ADAPTIVE_RANGE
+    return float(radius) * float(ADAPTIVE_RANGE[1])
