@@ -63,7 +63,7 @@ if TYPE_CHECKING:
     # Static checkers (mypy, pyright, IDEs) see every public name with its real type;
     # at run time nothing here is imported and ``__getattr__`` below resolves the
     # names on first use.  Keep in step with _LAZY_MODULES / _LAZY_ATTRS
-    # (tests/test_typing.py checks that the two agree).
+    # (tests/app/test_typing.py checks that the two agree).
     from . import (baselines, batch, benchmarks, biharmonic, boundary_estimation, cli, convergence, curvature,
                    demos, errors, features, hhj, interop, mesh, mesh_io, mesh_report, polygon_io, recovery, regge,
                    repair, surfaces, viewer, vtk_files)

@@ -140,7 +140,7 @@ def estimate_boundary_normals(mesh: TriangleMesh, rings=FIT_RINGS, *, reference=
         Fit neighbourhood in rings; vertices with fewer than 10 neighbours there
         (corners) use one ring more.  Wider fits pass less normal noise into
         the clamped data and cost a larger constant on clean meshes; all keep
-        the O(h²) rate (``tests/test_recovery.py``).
+        the O(h²) rate (``tests/vertex_stage/test_recovery.py``).
     reference : bool, default False
         Fit with the numpy reference :func:`boundary_normal_fits_reference` instead of
         the compiled :func:`igl_hhj.kernels.boundary_normal_fits` (the same to round-off).

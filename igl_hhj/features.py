@@ -269,7 +269,7 @@ def cut_along(mesh: TriangleMesh, crease: NDArray[np.bool_], *, reference: bool 
 
     Compiled (:func:`igl_hhj.kernels.crease_cut`: one union-find over the corners and the
     numbering in one pass); ``reference=True``: the numpy reference
-    :func:`cut_along_reference` (the same arrays, tests/test_features.py).
+    :func:`cut_along_reference` (the same arrays, tests/vertex_stage/test_features.py).
 
     ``igl.cut_mesh`` was not used: on a cube cut along its 12 edges it returns 28
     vertices instead of 24 (it cuts to disk topology).

@@ -43,7 +43,7 @@ preconditioner is a scalar per vertex, so CG's iterates transform the same way).
 
 The compiled kernels (:func:`igl_hhj.kernels.intrinsic_patch_recovery`,
 :func:`igl_hhj.kernels.intrinsic_smoothing`) compute the same; this module is
-their readable numpy reference (``tests/test_intrinsic.py`` compares them).
+their readable numpy reference (``tests/vertex_stage/test_intrinsic.py`` compares them).
 """
 from __future__ import annotations
 

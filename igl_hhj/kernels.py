@@ -5,7 +5,7 @@ coerces its arrays once (C-contiguous float64 / int64, shapes; the topology maps
 :class:`igl_hhj.mesh.TriangleMesh` as they are stored, int32 indices and int8 local
 indices, so no call copies them) and hands them to one C++ kernel; the kernels have no hidden state and release the GIL.  The
 readable numpy reference of each kernel is named in its docstring; tests
-(``tests/test_core.py``) compare the two.
+(``tests/core/test_core.py``) compare the two.
 
 Threads: a kernel uses all OpenMP threads (``OMP_NUM_THREADS``) when it is the
 only igl_hhj kernel running, and one thread when called while another one runs

@@ -28,7 +28,7 @@ Numerical-robustness policy (one set of limits for every solver)
   baselines and the Regge layer) compute areas from edge lengths, whose
   relative error grows like ``ε/r²`` for a face of relative area ``r``: at
   ``r = 1e-7`` a cotangent weight is still good to ~1 %, at ``r = 1e-8`` it is
-  off by ~100 % and below ``3e-9`` it is NaN (``tests/test_mesh.py::
+  off by ~100 % and below ``3e-9`` it is NaN (``tests/mesh/test_mesh.py::
   test_threshold_matches_libigl_precision`` measures this).
 * Coordinates are bounded by ``COORDINATE_MAX = 1e75`` and the longest edge must
   be at least ``MIN_MESH_SIZE = 1e-60``: beyond that, squared areas in the

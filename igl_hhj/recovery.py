@@ -12,7 +12,7 @@ few sparse products:
   plane.  The face weights (:func:`recovery_weights`) are the areas, reduced
   on slivers and their edge neighbours: a sliver accepted by validation
   (relative area 1e-12) carries a tensor of size ~1/its height that must not
-  reach its vertices (``tests/test_recovery.py`` checks |κ - 1| < 0.15 next to
+  reach its vertices (``tests/vertex_stage/test_recovery.py`` checks |κ - 1| < 0.15 next to
   a 1e-11 face on the unit sphere).
 * **smoothing** (:func:`smooth_vertex_tensors`): implicit diffusion steps
   ``(M + t L) X = M X_prev`` of the six components of the ambient tensor
@@ -422,7 +422,7 @@ def recover_and_smooth(mesh: TriangleMesh, S, length, *, weights=None, normals=N
     """Compiled patch recovery + smoothing of the drop-in (one pass each, no sparse matrices).
 
     Equals ``smooth_vertex_tensors(mesh, *recover_vertex_tensors(mesh, S, weights=w), length,
-    weights=w)`` (the numpy reference, compared in ``tests/test_core.py``): the
+    weights=w)`` (the numpy reference, compared in ``tests/core/test_core.py``): the
     patch recovery (:func:`igl_hhj.kernels.patch_recovery`), then ``steps × order``
     Jacobi-PCG diffusion solves on the vertex graph
     (:func:`igl_hhj.kernels.smooth_vertex_tensors`, entries from

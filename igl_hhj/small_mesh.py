@@ -22,7 +22,7 @@ arrays, with the default options (open meshes with ``boundary="estimate"``).  Wh
 the general path would do anything else -- raise, warn (an unwelded mesh), repair, use
 another solver or fall back to one -- the kernel returns a nonzero status and
 :func:`try_dropin` returns None: the caller takes the general path, which then does
-exactly that.  ``tests/test_small_mesh.py`` asserts that both paths give the same bits
+exactly that.  ``tests/vertex_stage/test_small_mesh.py`` asserts that both paths give the same bits
 on closed, open, multi-component, folded and unreferenced-vertex meshes, and that every
 defect class goes to the general path.
 """

@@ -568,7 +568,7 @@ _SINGULAR = {"vertices": "vertex", "faces": "face", "nodes": "node", "edges": "e
 def _set(method, *args):
     """Call a polyscope quantity setter for its effect.  polyscope 2.6's bindings return
     the quantity itself from setters such as ``set_color_map``; in some processes (about
-    one run in four of ``tests/test_view.py`` after other tests) nanobind fails to
+    one run in four of ``tests/app/test_view.py`` after other tests) nanobind fails to
     convert that returned ``SurfaceScalarQuantity`` reference ("Unable to convert
     function return value ..."), after the C++ setter has run.  That error is ignored:
     the setting is made, only the unused return value is lost; any other error is

@@ -7,7 +7,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-MESH_DIR = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "meshes"
+ROOT = Path(__file__).resolve().parents[1]
+"""The repository root (tests/ is one level below it)."""
+MESH_DIR = ROOT.parent / "shared" / "data" / "meshes"
 
 
 def real_mesh_paths():

@@ -1,5 +1,5 @@
 // The drop-in's intrinsic smoothing (igl_hhj/intrinsic.py is the readable numpy
-// reference; tests/test_intrinsic.py compares them): twiced implicit diffusion of the
+// reference; tests/vertex_stage/test_intrinsic.py compares them): twiced implicit diffusion of the
 // per-vertex components X = (h, Re z, Im z), h with the scalar cotangent Laplacian and
 // the spin-2 deviator z with the connection Laplacian (L_c z)_i = sum_j w_ij (z_i -
 // r_ij z_j).  One Jacobi PCG per solve, with separate CG scalars for every (connected

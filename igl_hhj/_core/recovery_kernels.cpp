@@ -1,5 +1,5 @@
 // Vertex recovery and smoothing of the drop-in (igl_hhj/recovery.py is the readable
-// numpy reference of every kernel here; tests/test_core.py compares them):
+// numpy reference of every kernel here; tests/core/test_core.py compares them):
 // face reliability weights, the patch recovery (weighted linear least-squares fit
 // in each vertex's tangent frame), the trace-keeping tangent projection and the
 // twiced implicit diffusion of the six tensor components (CSR assembled from the

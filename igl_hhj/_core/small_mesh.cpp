@@ -4,7 +4,7 @@
 // system, its direct solve, S_h, the vertex stage, the eigen-problem), each a few
 // microseconds: 0.3 ms on a 12-face cube against libigl's 0.05 ms.  On a small
 // closed mesh this kernel runs the same compiled kernels in the same order with the
-// same inputs, so it returns the general path's values (tests/test_small_mesh.py
+// same inputs, so it returns the general path's values (tests/vertex_stage/test_small_mesh.py
 // compares them); anything else -- an open boundary, a defect the general path would
 // refuse or repair, more edges than the envelope solver takes, a solve that fails --
 // returns a nonzero status and the caller takes the general path.

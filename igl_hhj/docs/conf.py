@@ -1,4 +1,4 @@
-"""Sphinx configuration of the igl_hhj documentation (built by tests/test_docs.py with -W).
+"""Sphinx configuration of the igl_hhj documentation (built by tests/app/test_docs.py with -W).
 
 Pages are Markdown (MyST) or reStructuredText; the pictures are referenced where they
 live, in ``demos/images/`` of the source tree (``../../demos/images/NAME.png`` from

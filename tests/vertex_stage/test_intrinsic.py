@@ -15,7 +15,7 @@ from igl_hhj import recovery as rc
 from igl_hhj.mesh import TriangleMesh
 from igl_hhj.surfaces import Sphere, icosphere, jitter_tangentially
 
-MESHES = Path(__file__).resolve().parents[2] / "shared" / "data" / "meshes"
+MESHES = Path(__file__).resolve().parents[3] / "shared" / "data" / "meshes"
 
 
 def voronoi_areas(V, F):

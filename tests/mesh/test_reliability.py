@@ -99,6 +99,7 @@ def test_threshold_matches_libigl_precision():
     assert worst_error(DEGENERATE_AREA_RTOL / 30) > 0.5
 
 
+@pytest.mark.slow
 def test_hhj_auto_on_large_mesh_with_thin_face(large_grid):
     """Issue: one face of relative area 1e-9 on > 50k edges crashed solver='auto'
     with LinAlgError.  Now: rejected by validation with the cause; just above the

@@ -24,6 +24,7 @@ def _rates(name, order, degree, levels, boundary="none", data="walker"):
     return errs, eoc(errs, hs)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name,order,degree", [
     ("torus", 2, 1), ("ellipsoid", 2, 1), ("torus", 3, 2), ("ellipsoid", 3, 2), ("torus", 3, 1)])
 def test_theorem_4_1_rate_closed(name, order, degree):
@@ -33,6 +34,7 @@ def test_theorem_4_1_rate_closed(name, order, degree):
     assert errs[-1] < errs[0] / 2 ** (2 * degree + 1), errs
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("order", [2, 3])
 def test_theorem_4_1_rate_clamped_saddle(order):
     """With clamped data ξ̃ = I_h^m ∇_Γ w (eq. 4.9's Σ_c term) the full rate r + 1 holds on a surface
@@ -48,6 +50,7 @@ def test_theorem_4_1_rate_clamped_saddle(order):
     assert rates_0[-1] < 1.0 and errs_0[-1] > 10 * errs[-1], (errs_0, rates_0)
 
 
+@pytest.mark.slow
 def test_nodal_data_lose_an_order_at_m3():
     """Remark 4.2's interpolant must be Walker's moment interpolant 𝓘_h^{1,m} (Fortin property 4.6):
     nodal values w(Ψ^m(x_a)) on the same surface converge one order slower (measured 2.0 vs 3.0)."""

@@ -435,6 +435,7 @@ def test_mesh_generator_checks():
 
 
 # ----------------------------------------------------------------- benchmark smoke test
+@pytest.mark.slow
 def test_benchmark_run_tiny(tmp_path):
     """The benchmark's run() on tiny sizes: tables, EOCs and the perf comparison."""
     from igl_hhj.benchmarks.biharmonic_convergence import run

@@ -83,6 +83,7 @@ def crease_study(request):
     return request.param, s, np.array(rows)
 
 
+@pytest.mark.slow
 def test_band_converges_with_features_and_not_without(crease_study):
     name, s, rows = crease_study
     hs, on, off, Hmax = rows[:, 0], rows[:, 1], rows[:, 2], rows[-1, 6]
@@ -338,6 +339,7 @@ def test_cli_and_batch_feature_angle(tmp_path, capsys):
         assert "feature-angle" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_cli_screenshot_draws_the_creases(tmp_path):
     import os
     import subprocess
@@ -348,7 +350,7 @@ def test_cli_screenshot_draws_the_creases(tmp_path):
     V, F, _ = capped_cylinder(1)
     path = tmp_path / "capped.off"
     igl.write_triangle_mesh(str(path), V, F)
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     env = dict(os.environ, PYTHONPATH=root + os.pathsep + os.environ.get("PYTHONPATH", ""))
     pngs = {}
     for tag, extra in (("off", []), ("on", ["--feature-angle", "40"])):
@@ -418,7 +420,7 @@ def test_cut_mesh_costs_one_solve_and_one_validation(monkeypatch):
 def test_parts_of_the_callers_mesh_stay_independent():
     """Two disjoint parts: each part's values with features do not depend on the other
     (its own solve group, as without features; issue 23's locality, to the same ≤ 1e-12
-    absolute as tests/test_intrinsic.py::test_components_do_not_see_each_other)."""
+    absolute as tests/vertex_stage/test_intrinsic.py::test_components_do_not_see_each_other)."""
     V, F, _ = capped_cylinder(2)
     V2 = np.vstack([V, V * 0.5 + (5.0, 0.0, 0.0)])
     F2 = np.vstack([F, F + len(V)])

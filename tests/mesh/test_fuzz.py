@@ -111,6 +111,7 @@ def large_grid():
     return V, F
 
 
+@pytest.mark.slow
 @FEW
 @given(seed=st.integers(0, 2**32 - 1), log_rel=st.floats(-0.5, 2.0))
 def test_slivers_at_the_threshold_on_a_large_mesh(large_grid, seed, log_rel):
@@ -272,6 +273,7 @@ def _mutate(data, kind, seed):
     return bytes(b)
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="RLIMIT_AS / /proc are Linux")
 @settings(max_examples=4, deadline=None, suppress_health_check=[HealthCheck.too_slow,
                                                                   HealthCheck.function_scoped_fixture])
@@ -308,6 +310,7 @@ def test_valid_files_are_accepted(tmp_path):
         assert len(F) == len(F1), fmt
 
 
+@pytest.mark.slow
 def test_defect_meshes_against_libigl():
     """1,000 seeded small spheres / tori with 1-3 defects each (duplicate and reversed
     duplicate faces, flips, fins, zero-area faces, repeated corners, slivers, holes,

@@ -24,7 +24,7 @@ import pytest
 
 from conftest import MESH_DIR, png_stats, require_egl
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 DEMOS = ["quickstart", "compare_curvature", "refinement", "boundary_data", "biharmonic", "regge", "curved",
          "features"]
 SIZE = (320, 200)
@@ -106,6 +106,7 @@ def test_bad_options_exit_nonzero():
 
 
 # --------------------------------------------------------------------------- rendering
+@pytest.mark.slow
 def test_quickstart(tmp_path, requires_egl):
     out = run_demo("quickstart", tmp_path, "--out-dir", str(tmp_path))
     for step in ("1. read", "2. verdict accepted by igl_hhj", "3. curvature", "4. picture: wrote", "5. saved"):
@@ -116,6 +117,7 @@ def test_quickstart(tmp_path, requires_egl):
     assert d["H"].shape == (len(V),) and np.isfinite(d["H"]).all() and len(F) == len(d["F"])
 
 
+@pytest.mark.slow
 def test_compare_curvature_generated(tmp_path, requires_egl):
     out = run_demo("compare_curvature", tmp_path)
     header, body = table_rows(out, "Relative L2 error against the exact curvature")
@@ -126,6 +128,7 @@ def test_compare_curvature_generated(tmp_path, requires_egl):
     assert re.search(r"colour range of H \(both copies\): \[-[\d.]+, [\d.]+\]", out)
 
 
+@pytest.mark.slow
 def test_compare_curvature_mesh_file(tmp_path, requires_egl):
     path = MESH_DIR / "bunny.off"
     if not path.exists():
@@ -138,6 +141,7 @@ def test_compare_curvature_mesh_file(tmp_path, requires_egl):
         assert p1 <= p50 <= p99
 
 
+@pytest.mark.slow
 def test_refinement(tmp_path, requires_egl):
     out = run_demo("refinement", tmp_path, "--levels", "3", "--plot", str(tmp_path / "conv.png"))
     header, body = table_rows(out, "Relative L2 error of the mean curvature H")
@@ -150,6 +154,7 @@ def test_refinement(tmp_path, requires_egl):
     assert (tmp_path / "conv.png").exists()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("surface", ["saddle", "dumbbell"])
 def test_boundary_data(tmp_path, requires_egl, surface):
     pytest.importorskip("triangle")
@@ -163,6 +168,7 @@ def test_boundary_data(tmp_path, requires_egl, surface):
     assert number(linf[-1][6]) > 0.5 and number(linf[-1][8]) > 0.5, out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("bc", ["clamped", "navier", "closed"])
 def test_biharmonic(tmp_path, requires_egl, bc):
     out = run_demo("biharmonic", tmp_path, "--bc", bc, "--levels", "3")
@@ -173,6 +179,7 @@ def test_biharmonic(tmp_path, requires_egl, bc):
     assert "Stein et al. 2022" in out
 
 
+@pytest.mark.slow
 def test_regge(tmp_path, requires_egl):
     out = run_demo("regge", tmp_path, "--levels", "2")
     header, body = table_rows(out, "Gauss–Bonnet")
@@ -183,6 +190,7 @@ def test_regge(tmp_path, requires_egl):
         assert 0 < number(r[col["min angle (°)"]]) < 60
 
 
+@pytest.mark.slow
 def test_regge_mesh_file(tmp_path, requires_egl):
     path = MESH_DIR / "bunny.off"
     if not path.exists():
@@ -193,6 +201,7 @@ def test_regge_mesh_file(tmp_path, requires_egl):
     assert abs(total - two_pi_chi) < 1e-8 * max(1.0, abs(two_pi_chi))
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="display detection differs off Linux")
 def test_interactive_without_display_is_a_one_line_error(requires_egl):
     """No --screenshot and no display: polyscope falls back to a windowless backend;
@@ -206,6 +215,7 @@ def test_interactive_without_display_is_a_one_line_error(requires_egl):
 
 
 # --------------------------------------------------------------------------- first ten minutes (issue 26)
+@pytest.mark.slow
 def test_missing_demo_package_is_a_clear_error_not_an_internal_one(capsys, monkeypatch):
     """``igl-hhj demo curved`` on a plain install (no gpytoolbox) used to end in
     'internal error: ModuleNotFoundError' (exit 70): now one line naming the package
@@ -223,6 +233,7 @@ def test_missing_demo_package_is_a_clear_error_not_an_internal_one(capsys, monke
     assert res.returncode == 2 and 'pip install ".[demos]"' in res.stderr, res.stderr
 
 
+@pytest.mark.slow
 def test_quickstart_creates_its_out_dir(tmp_path):
     """--out-dir used to have to exist ('no such directory'); it is created now."""
     out = tmp_path / "new" / "results"
@@ -235,6 +246,7 @@ def test_quickstart_creates_its_out_dir(tmp_path):
     assert res.returncode == 2 and "is a file, not a folder" in res.stderr
 
 
+@pytest.mark.slow
 def test_features_demo(tmp_path, requires_egl):
     import igl
 

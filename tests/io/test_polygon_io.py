@@ -306,7 +306,7 @@ def _walker_torus_quads(n):
 def test_curvature_of_quad_files_converges(tmp_path, ext):
     """Quad meshes read from files (binary PLY: numpy; VTP: pyvista) and split by the fan
     rule give HHJ vertex curvatures that converge to Walker's torus at the drop-in's rate
-    (EOC >= 0.9 on the finest pair, as tests/test_curvature.py asks of triangle meshes)."""
+    (EOC >= 0.9 on the finest pair, as tests/hhj/test_curvature.py asks of triangle meshes)."""
     import igl_hhj
     from igl_hhj.convergence import eoc, vertex_errors
     from igl_hhj.surfaces.exact import WalkerTorus

@@ -36,6 +36,7 @@ def _rates(name, order, levels, boundary="none", interpolant="walker"):
 
 
 # ----------------------------------------------------------------------------- rates
+@pytest.mark.slow
 @pytest.mark.parametrize("name,levels,boundary", [
     ("sphere", 3, "none"), ("torus", 3, "none"), ("saddle", 3, "clamped")])
 def test_eoc_m2(name, levels, boundary):
@@ -43,6 +44,7 @@ def test_eoc_m2(name, levels, boundary):
     assert rates[-1] >= 1.8, (errs, rates)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name,levels,boundary", [
     ("sphere", 3, "none"), ("torus", 3, "none"), ("saddle", 3, "clamped")])
 def test_eoc_m3(name, levels, boundary):
@@ -50,12 +52,14 @@ def test_eoc_m3(name, levels, boundary):
     assert rates[-1] >= 2.7, (errs, rates)
 
 
+@pytest.mark.slow
 def test_eoc_simply_supported_saddle():
     for m, lo in ((2, 1.8), (3, 2.7)):
         errs, rates = _rates("saddle", m, 3, "simply_supported")
         assert rates[-1] >= lo, (m, errs, rates)
 
 
+@pytest.mark.slow
 def test_modified_interpolant_is_needed_for_m3():
     """Walker §4.5: for m = r + 1 the modified interpolant (4.14) is necessary; the
     standard nodal one loses an order at m = 3 (measured: EOC 2.1 vs 3.1 on the sphere)."""
@@ -304,6 +308,7 @@ def _heine_rates(label, degree, levels=4):
     return {k: eoc([r[k] for r in rows], hs) for k in ("K2", "H2", "Y2", "Pi2")}
 
 
+@pytest.mark.slow
 def test_heine_degree2_converges_degree1_does_not():
     """Heine Tables 5.1–5.4: γ = 2 converges (EOC 1.1–2.4 there), γ = 1 does not
     (measured on the re-jittered ellipsoid sequence: γ = 2 EOC ≈ 1.3; γ = 1 ≈ 0)."""
@@ -313,6 +318,7 @@ def test_heine_degree2_converges_degree1_does_not():
     assert r1["H2"][-1] <= 0.5, r1
 
 
+@pytest.mark.slow
 def test_order4_surface_nodal_interpolant():
     """Order m = 4 (gmsh triangle15, nodal interpolant of the projection): the sphere's area
     error falls at ≥ h^5 (measured EOC 8.9, 5.7); Walker's modified interpolant is m ≤ 3 only."""
@@ -392,6 +398,7 @@ def test_display_mesh_is_a_closed_manifold_with_values():
         display_mesh(surf, fld, subdivisions=0)
 
 
+@pytest.mark.slow
 def test_curved_demo_headless(tmp_path):
     """demos/curved.py renders the three orders and prints errors falling with m."""
     import subprocess
@@ -399,7 +406,7 @@ def test_curved_demo_headless(tmp_path):
     from pathlib import Path
     from conftest import png_stats, require_egl
     require_egl()
-    root = Path(__file__).resolve().parents[1]
+    root = Path(__file__).resolve().parents[2]
     png = tmp_path / "curved.png"
     res = subprocess.run([sys.executable, "demos/curved.py", "--screenshot", str(png), "--size", "360", "160",
                           "--subdivisions", "1"], cwd=root, capture_output=True, text=True, timeout=300)
@@ -437,6 +444,7 @@ def test_walker_tables_orders_cli(tmp_path, capsys):
     assert all(len(PAPER_CURVED[n][m]) >= 4 for n in PAPER_CURVED for m in (2, 3))
 
 
+@pytest.mark.slow
 def test_walker_tables_append_min_level(tmp_path):
     """--min-level skips the coarse solves (rows carry their k; no EOC without the level
     before); --append adds a section with the command line and the ours/paper line."""

@@ -214,6 +214,7 @@ def test_heine_sphere_is_unit_sphere():
 
 
 # ----------------------------------------------------------------- benchmark smoke test
+@pytest.mark.slow
 def test_compare_estimators_quick_run(tmp_path):
     pytest.importorskip("tqdm")
     pytest.importorskip("matplotlib")

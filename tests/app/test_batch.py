@@ -116,6 +116,7 @@ def collection(tmp_path_factory):
 
 
 # --------------------------------------------------------------------------- embedded
+@pytest.mark.slow
 def test_embedded_cluster_rows_and_outputs_equal_curvature(collection, tmp_path, capsys):
     folder, good, bad = collection
     out = tmp_path / "out"
@@ -169,6 +170,7 @@ def test_in_process_formats_and_options(collection, tmp_path, capsys):
             np.testing.assert_allclose(m.point_data[k], r[k], rtol=1e-12)
 
 
+@pytest.mark.slow
 def test_user_errors(collection, tmp_path, capsys, monkeypatch):
     folder, good, _ = collection
     assert [cli._memory_bytes(t) for t in ("4G", "512MiB", "2e9", "1500k")] == \
@@ -208,6 +210,7 @@ def test_user_errors(collection, tmp_path, capsys, monkeypatch):
     assert {r["status"] for p, r in rows.items() if p.endswith(".off") and "sub" in p} == {"ok"}
 
 
+@pytest.mark.slow
 def test_timeout_and_memory_limit(tmp_path):
     """Sandboxed meshes: killed past the timeout (status timeout) or the memory limit (error)."""
     V, F = igl.icosahedron()
@@ -232,6 +235,7 @@ def test_timeout_and_memory_limit(tmp_path):
     assert rows["small.obj"]["status"] == "ok"
 
 
+@pytest.mark.slow
 def test_worker_that_keeps_dying_is_an_error_row(tmp_path):
     """A mesh whose worker process dies every time (here: SIGKILL while it computes it) is
     retried a bounded number of times, separated from the meshes grouped with it, then an error row."""
@@ -285,6 +289,7 @@ def _wait_for(pred, timeout, what):
         time.sleep(0.05)
 
 
+@pytest.mark.slow
 def test_resume_after_sigint(tmp_path):
     folder = tmp_path / "in"
     good, bad = write_collection(folder, n=24, levels=(4,), seed=1)   # 5120 faces each
@@ -380,6 +385,7 @@ def loopback_cluster(tmp_path_factory):
         log.close()
 
 
+@pytest.mark.slow
 def test_loopback_cluster(loopback_cluster, collection, tmp_path):
     address, _ = loopback_cluster
     folder, good, bad = collection
@@ -395,6 +401,7 @@ def test_loopback_cluster(loopback_cluster, collection, tmp_path):
         assert_same_npz(rows[str(p)]["output"], curvature_reference(p, tmp_path))
 
 
+@pytest.mark.slow
 def test_loopback_cluster_survives_a_killed_worker(loopback_cluster, tmp_path):
     """Kill one of the two workers mid-run: every mesh still ends with a row, none is lost."""
     address, workers = loopback_cluster
@@ -419,6 +426,7 @@ def test_loopback_cluster_survives_a_killed_worker(loopback_cluster, tmp_path):
     assert_same_npz(rows[str(good[0])]["output"], curvature_reference(good[0], tmp_path))
 
 
+@pytest.mark.slow
 def test_benchmark_runs_small(tmp_path):
     from igl_hhj.benchmarks import batch as bench
     res = bench.run(n=6, seed=1, workers=(1,), chunks=2, progress=False, mesh_dir=tmp_path / "none")
@@ -429,6 +437,7 @@ def test_benchmark_runs_small(tmp_path):
     assert table.count("\n| ") == 3 and "speed-up over the loop" in table
 
 
+@pytest.mark.slow
 def test_progress_bar_on_a_terminal(collection, tmp_path):
     """tqdm bar (done, failed, rate) when stderr is a terminal; plain lines are tested above."""
     pytest.importorskip("tqdm")
@@ -555,6 +564,7 @@ def _unwelded(path):
     return path
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("workers", ["0", "1"])
 def test_warnings_reach_the_summary_and_stderr(collection, tmp_path, capsys, workers):
     """On Dask the workers' warnings used to be lost: each row has a ``warnings``

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _mypy(*args, cwd):
@@ -22,6 +22,7 @@ def _mypy(*args, cwd):
                           timeout=600, env=env)
 
 
+@pytest.mark.slow
 def test_mypy_on_the_package():
     pytest.importorskip("mypy")
     files = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["mypy"]["files"]
@@ -128,6 +129,7 @@ def _revealed(stdout):
     return out
 
 
+@pytest.mark.slow
 def test_user_script_sees_the_real_types(tmp_path):
     """mypy on a user's script (outside the repository, default settings) that imports
     igl_hhj like any installed package: the public functions have their annotated

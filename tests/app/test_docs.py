@@ -12,7 +12,7 @@ import pytest
 
 from test_readme import bunny_folder, python_blocks, run_blocks
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "igl_hhj" / "docs"
 IMAGES = ROOT / "demos" / "images"
 PAGES = sorted(p for p in DOCS.iterdir() if p.suffix in (".md", ".rst") and p.stem != "index")
@@ -34,6 +34,7 @@ def html(tmp_path_factory):
     return out
 
 
+@pytest.mark.slow
 def test_api_reference_builds_without_warnings(html):
     api = (html / "api.html").read_text()
     for name in ("shape_operator", "principal_curvature", "plot_convergence", "register_comparison",
@@ -83,6 +84,7 @@ def test_estimator_table_is_included_from_the_readme(html):
         assert row in results, row
 
 
+@pytest.mark.slow
 def test_tutorial_python_runs_as_written(tmp_path):
     """The README's former walk-through: the whole API, mesh objects, viewer (mock backend)."""
     folder = bunny_folder(tmp_path)
@@ -93,6 +95,7 @@ def test_tutorial_python_runs_as_written(tmp_path):
     assert (folder / "bunny_S.vtu").stat().st_size > 0
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("page", ["papers.md", "batch.md"])
 def test_page_python_runs_as_written(tmp_path, page):
     folder = bunny_folder(tmp_path)

@@ -68,6 +68,7 @@ def _min_angle(V, F):
 
 
 # --------------------------------------------------------------------------- convergence vs the paper
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["saddle", "dumbbell", "torus", "genus3"])
 def test_walker_table_rates_and_paper_errors(name):
     from igl_hhj.benchmarks.walker_tables import PAPER_TABLES
@@ -132,6 +133,7 @@ def _check_mesh(V, F, surface, closed):
     return _min_angle(V, F)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["saddle", "dumbbell", "torus", "genus3"])
 def test_mesh_generators(name):
     surface, seq = _sequence(name)
@@ -266,6 +268,7 @@ def test_implicit_meshing_input_checks():
         implicit_coarse(s, [-1.2] * 3, [1.2] * 3, 2)
 
 
+@pytest.mark.slow
 def test_benchmark_run_tiny(tmp_path):
     pytest.importorskip("matplotlib")
     from igl_hhj.benchmarks.walker_tables import condition_numbers, run, surface_levels

@@ -108,6 +108,7 @@ def render_or_skip(argv, capsys):
     return code, cap
 
 
+@pytest.mark.slow
 def test_demo_writes_screenshot(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     code, cap = render_or_skip(["demo", "--levels", "2"], capsys)
@@ -268,6 +269,7 @@ def test_failed_run_keeps_existing_output(tmp_path, capsys):
     assert out.read_text() == "previous results\n"
 
 
+@pytest.mark.slow
 def test_curvature_real_mesh_with_boundary(tmp_path, capsys):
     path = real_mesh("camelhead.off")
     out = tmp_path / "camel.csv"
@@ -505,6 +507,7 @@ def test_info_stl_vertices_are_welded(tmp_path, capsys):
     assert "merged coincident STL vertices" in cap.err
 
 
+@pytest.mark.slow
 def test_info_subprocess_exit_codes(sphere, tmp_path):
     path, _, _ = sphere
     run = subprocess.run([sys.executable, "-m", "igl_hhj.cli", "info", str(path)],
@@ -534,7 +537,7 @@ BAD_FILES = {
                         b"property float z\nelement face 2\nproperty list uchar int vertex_indices\n"
                         b"end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"),           # libigl: double free
     # (a PLY of mixed triangles and quads, on which libigl aborts, is read with numpy since
-    # issue 26: tests/test_polygon_io.py)
+    # issue 26: tests/io/test_polygon_io.py)
     "short_quad.ply": (b"ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
                        b"property float z\nelement face 2\nproperty list uchar int vertex_indices\n"
                        b"end_header\n0 0 0\n1 0 0\n0 1 0\n1 1 1\n3 0 1 2\n4 0 1 2\n"),
@@ -588,6 +591,7 @@ def test_usage_errors_are_one_line(capsys):
     assert "--method" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_demo_without_egl_end_to_end(tmp_path):
     """A real process whose libEGL cannot be loaded (shadowed by an empty file):
     the table, one warning line naming the Debian packages, exit 0, no picture,
@@ -637,6 +641,7 @@ def test_named_demo_help_and_bad_name(capsys):
     assert len(err) == 1 and err[0].startswith("igl-hhj demo regge: error: --levels")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("argv", [["demo", "--levels", "1"],
                                   ["demo", "regge", "--levels", "2", "--screenshot", "r.png", "--size", "64", "64"]])
 def test_demos_leave_no_files_and_no_egl_chatter(tmp_path, argv):

@@ -46,7 +46,7 @@ def test_extras_and_license():
     """A `demos` extra with what the demos import, an `all` extra, and the MPL-2.0 text."""
     import tomllib
     from pathlib import Path
-    root = Path(__file__).resolve().parents[1]
+    root = Path(__file__).resolve().parents[2]
     extras = tomllib.loads((root / "pyproject.toml").read_text())["project"]["optional-dependencies"]
     names = {e: {r.split(">")[0].split("[")[0].split("=")[0].strip() for r in reqs} for e, reqs in extras.items()}
     assert {"matplotlib", "triangle", "gpytoolbox"} <= names["demos"]
@@ -59,6 +59,6 @@ def test_a_plain_install_annotates_screenshots():
     so matplotlib (and with it Pillow, for the palette PNGs) is a core dependency."""
     import tomllib
     from pathlib import Path
-    root = Path(__file__).resolve().parents[1]
+    root = Path(__file__).resolve().parents[2]
     deps = tomllib.loads((root / "pyproject.toml").read_text())["project"]["dependencies"]
     assert "matplotlib" in {r.split(">")[0].split("[")[0].split("=")[0].strip() for r in deps}

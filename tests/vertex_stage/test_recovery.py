@@ -27,6 +27,7 @@ def _rates(errs, key):
 
 
 # --------------------------------------------------------------------------- rates, default arguments
+@pytest.mark.slow
 def test_dropin_default_rates_closed_and_beats_libigl_default():
     """Default drop-in (radius=5: smoothing length = mean edge length) on the
     non-uniform ellipsoid sequence: EOC ≥ 0.9 for H, K and the max error; the
@@ -131,6 +132,7 @@ def _noisy(V, F, surface, sigma, seed):
     return V + sigma * h * np.random.default_rng(seed).normal(size=(len(V), 1)) * surface.normal(V)
 
 
+@pytest.mark.slow
 def test_noise_dropin_beats_libigl_default():
     """0.02·h normal noise on the 82k-face ellipsoid: the default drop-in's rms H
     error is below igl.principal_curvature's default (issue 11: it was 3.8× above)."""

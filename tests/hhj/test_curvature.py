@@ -76,7 +76,7 @@ def test_mixed_boundary_partition():
 
 def test_vertex_recovery_rates():
     """The drop-in's recovered per-vertex curvatures at its smallest smoothing scale
-    (radius=1) converge at least at O(h), also in max norm (tests/test_recovery.py
+    (radius=1) converge at least at O(h), also in max norm (tests/vertex_stage/test_recovery.py
     checks the default radius against libigl)."""
     surface, seq = sequence("ellipsoid", 5)
     errs = []

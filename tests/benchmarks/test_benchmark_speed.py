@@ -5,6 +5,7 @@ import pytest
 from igl_hhj.benchmarks import speed
 
 
+@pytest.mark.slow
 def test_speed_run_quick():
     rows = speed.run(speed.QUICK, repeat=1, progress=False, memory=True, fresh=2)
     assert len(rows) == 3
@@ -47,6 +48,7 @@ def test_rtol_study_small():
     assert "change vs rtol 1e-12" in speed.rtol_markdown(rows)
 
 
+@pytest.mark.slow
 def test_profile_stages_follows_the_default_drop_in():
     """--profile: every stage of the default drop-in timed, with its iterations and faults."""
     from igl_hhj.benchmarks.speed import profile_stages

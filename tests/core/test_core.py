@@ -295,7 +295,7 @@ def _vertex_stage_meshes():
 def test_vertex_stage_equals_numpy_reference(name, smoothing):
     """The compiled ambient patch recovery + smoothing (recovery.recover_and_smooth) equals
     the numpy reference (recover_vertex_tensors + smooth_vertex_tensors), NaN rows included.
-    (The drop-in's intrinsic stage: tests/test_intrinsic.py.)"""
+    (The drop-in's intrinsic stage: tests/vertex_stage/test_intrinsic.py.)"""
     from igl_hhj.curvature import _vertex_shape_operator_numpy, vertex_shape_operator
     m = TriangleMesh(*_vertex_stage_meshes()[name])
     S = _shape_operator(m, None, None, None, "direct")
@@ -433,6 +433,7 @@ def test_fused_jacobi_pcg_equals_csr_preconditioner(closed):
     assert a[1] == b[1] and a[2] == b[2] == 0 and np.array_equal(a[0], b[0])
 
 
+@pytest.mark.slow
 def test_block_pcg_int32_and_int64_row_pointers_give_the_same_bits(closed, monkeypatch):
     """The HHJ system's fixed-width row pointer is int32 (memory at the solve): the PCG runs
     on it uncopied, with the operations of the int64 path; mixed types take the int64 one."""

@@ -4,7 +4,7 @@ block, in order, in one namespace, in a fresh folder holding the README's ``bunn
 copied from shared/data/meshes; the viewer on polyscope's mock backend with
 ``viewer.show`` a no-op), its links resolve, and its command table and install facts
 agree with the ``igl-hhj`` parser and pyproject.toml.  The code and numbers that moved
-to the Sphinx pages are checked there (tests/test_docs.py)."""
+to the Sphinx pages are checked there (tests/app/test_docs.py)."""
 from __future__ import annotations
 
 import re
@@ -18,7 +18,7 @@ import pytest
 
 from conftest import MESH_DIR
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 README = (ROOT / "README.md").read_text(encoding="utf-8")
 
 #: the two set-up commands; .ci/run executes line 2 of the first ```bash block

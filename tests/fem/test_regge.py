@@ -39,6 +39,7 @@ def test_reference_numbers_of_regge_md(k):
     assert Kh.h_minus1_error(ex.graph_gauss_curvature) == pytest.approx(hm1, rel=1e-4)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("k, l2_bound, hm1_bound", [(1, 1.4e-4, 9e-7), (2, 2.8e-6, 1.4e-8)])
 def test_rates_paper_example(k, l2_bound, hm1_bound):
     levels = [2, 3, 4, 5]
@@ -54,6 +55,7 @@ def test_rates_paper_example(k, l2_bound, hm1_bound):
     assert Hm1[-1] == pytest.approx(REGGE_MD[(k, 5)][1], rel=1e-4)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("k", [1, 2])
 def test_rates_on_random_diagonal_meshes(k):
     """Same example on a second non-uniform family (random diagonals + jitter,
@@ -110,6 +112,7 @@ def test_densitized_error_is_K_h_times_omega_h():
         Kd.l2_error(ex.graph_densitized_curvature, times_omega_h=True)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("k", [1, 2])
 def test_densitized_rates_and_pure_error_smaller(k):
     """Theorem 3.1 / Corollary 3.2 (densitized, r = 0): L2 k+1, H⁻¹ k+2; and the paper's §4
@@ -127,6 +130,7 @@ def test_densitized_rates_and_pure_error_smaller(k):
     assert L2[-1] < [1.5e-4, 3.1e-6][k - 1]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("k", [1, 2, 3])
 def test_broken_h1_rate_corollary_3_9(k):
     """Corollary 3.9 / 3.2 with r = 1, l = k + 1: ‖K_h − K̄‖_{H¹_h} and ‖K_h ω_h − K̄ ω̄‖_{H¹_h}
@@ -166,6 +170,7 @@ def test_h1_error_is_the_broken_h1_norm():
         Kh.h1_error(zero, zero)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("k, p, l2_rate, hm1_rate", [(2, 4, 1, 2), (3, 5, 2, 3), (3, 2, 3, 4)])
 def test_other_lifting_degrees_lose_orders(k, p, l2_rate, hm1_rate):
     """Paper §4, closing remarks (observed, not proven): K_h ∈ V_h^{k+2} loses two orders
@@ -232,6 +237,7 @@ def test_pointwise_gauss_curvature_sign_and_value():
     np.testing.assert_allclose(ex.sphere_metric(1.0)(X), g, rtol=1e-14)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("k, levels, bound", [(1, (3, 4, 5, 6), 3e-5), (2, (2, 3, 4, 5), 1.2e-6)])
 def test_constant_curvature_sphere_metric(k, levels, bound):
     """Stereographic sphere metric (K ≡ 1), Dirichlet K = 1 on ∂Ω: K_h → 1 at rate k+1.
@@ -433,6 +439,7 @@ def test_bad_input_raises_clear_errors():
         gauss_legendre(2.0)
 
 
+@pytest.mark.slow
 def test_benchmark_runs_on_tiny_sizes(tmp_path):
     pytest.importorskip("matplotlib")
     from igl_hhj.benchmarks import regge_convergence as bench

@@ -295,6 +295,7 @@ def _with_defects(V, F, kind, rng):
     return Vd, np.vstack([Fd, F[dup]]), pick
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["duplicate", "flip", "fin", "mixed"])
 def test_convergence_with_defects(kind):
     """~1 % of the faces duplicated / flipped / with a fin glued on, on the non-uniform
