@@ -73,8 +73,9 @@ def _warn_repairs(stats):
 @dataclass
 class TiledResult:
     """What :func:`curvature_file` did: the output directory (read it with
-    :func:`read_result`), the tiles' stats (also ``OUT/tiles.csv``), the number of bad
-    vertices, how the input was read, whether an earlier run was continued, the seconds."""
+    :func:`read_result`), the tiles' stats (also ``OUT/tiles.csv``), the mesh's size, the
+    number of bad vertices, how the input was read, whether an earlier run was continued,
+    the seconds, the tiles computed by this call."""
 
     out: Path
     stats: dict = field(default_factory=dict)
@@ -84,6 +85,8 @@ class TiledResult:
     read: str = ""
     resumed: bool = False
     seconds: float = 0.0
+    computed: list = field(default_factory=list)
+    """The tiles this call computed (the others were finished by an earlier run)."""
 
     @property
     def faces_computed(self) -> int:
@@ -151,14 +154,14 @@ def curvature_file(mesh_path, out_path, *, radius: float = 5, tile_faces: int = 
         cl = None
         if client is not None or scheduler is not None or (workers != 0 and plan.n_tiles > 1):
             cl, owned = open_client(client, scheduler, workers, retries, plan.n_tiles)
-        stats = run_tiles(source, plan, store, params, client=cl, retries=retries, progress=progress)
+        stats, computed = run_tiles(source, plan, store, params, client=cl, retries=retries, progress=progress)
     finally:
         for obj in owned:
             obj.close()
     bad = store.finish(stats)
     _warn_repairs(stats)
     return TiledResult(Path(out_path), stats, source.n_vertices, source.n_faces, int(len(bad)), how,
-                       resumed, time.perf_counter() - t0)
+                       resumed, time.perf_counter() - t0, computed)
 
 
 def principal_curvature(V: Any, F: Any = None, radius: float = 5, useKring: bool = True, *,
@@ -219,7 +222,7 @@ def principal_curvature(V: Any, F: Any = None, radius: float = 5, useKring: bool
         local = client is None and scheduler is None and (workers == 0 or plan.n_tiles == 1)
         if local:
             store = ArrayStore(len(V))
-            stats = run_tiles(ArraySource(V, F), plan, store, params, progress=progress)
+            stats, computed = run_tiles(ArraySource(V, F), plan, store, params, progress=progress)
             PD1, PD2, PV1, PV2 = (store.arrays[k] for k in ("PD1", "PD2", "PV1", "PV2"))
         else:
             np.save(tmp / "V.npy", V)
@@ -228,7 +231,7 @@ def principal_curvature(V: Any, F: Any = None, radius: float = 5, useKring: bool
             store = FileStore(tmp / "out")
             store.start({}, len(V), resume=False)
             cl, owned = open_client(client, scheduler, workers, retries, plan.n_tiles)
-            stats = run_tiles(source, plan, store, params, client=cl, retries=retries, progress=progress)
+            stats, computed = run_tiles(source, plan, store, params, client=cl, retries=retries, progress=progress)
             PD1, PD2, PV1, PV2 = (np.load(store.path(k)) for k in ("PD1", "PD2", "PV1", "PV2"))
     finally:
         for obj in owned:

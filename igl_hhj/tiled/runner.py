@@ -137,15 +137,19 @@ def run_tiles(source, plan, store, params, *, client=None, retries=2, progress=N
 
     Returns
     -------
-    dict {tile: stats} of every tile (finished earlier or now).
+    stats : dict {tile: stats} of every tile (finished earlier or now)
+    computed : list of the tiles computed by this call, in the order they finished
     """
     stats = {t: s for t in range(plan.n_tiles) if (s := store.done(t)) is not None}
     bar = Progress(plan.n_faces, progress)
     for s in stats.values():
         bar.update(s)
 
+    computed = []
+
     def on_done(s):
         stats[s["tile"]] = s
+        computed.append(s["tile"])
         bar.update(s)
 
     def run(todo, p):
@@ -167,7 +171,7 @@ def run_tiles(source, plan, store, params, *, client=None, retries=2, progress=N
             run([t for t in range(1, plan.n_tiles) if t not in stats], dict(params, rings=first, fixed=False))
     finally:
         bar.close()
-    return stats
+    return stats, computed
 
 
 def source_key(path):
