@@ -169,7 +169,7 @@ def principal_curvature(V: Any, F: Any = None, radius: float = 5, useKring: bool
                         eps: float = DEFAULT_TOLERANCE, client: Any = None, scheduler: str | None = None,
                         workers: int | None = None, rtol: float = 1e-6, solver: str = "auto",
                         boundary: str = "estimate", retries: int = 2, progress: bool | None = False,
-                        workdir: str | None = None):
+                        workdir: str | None = None, info: dict | None = None):
     """:func:`igl_hhj.principal_curvature` computed tile by tile (same call, same returns).
 
     Every vertex's values equal the whole-mesh call's to ``eps`` × max |κ| plus the
@@ -187,6 +187,9 @@ def principal_curvature(V: Any, F: Any = None, radius: float = 5, useKring: bool
     workdir : str, optional
         Directory for the arrays the workers read (default: a temporary directory; with a
         remote ``scheduler`` one that the workers see).
+    info : dict, optional
+        Receives ``tiles``: {tile: stats} (faces computed, rings, the radius the vertex
+        stage chose, seconds, peak memory, ...; the columns of ``tiles.csv``).
 
     Returns
     -------
@@ -238,6 +241,8 @@ def principal_curvature(V: Any, F: Any = None, radius: float = 5, useKring: bool
             obj.close()
         shutil.rmtree(tmp, ignore_errors=True)
     bad = ~(np.isfinite(PD1).all(axis=1) & np.isfinite(PD2).all(axis=1) & np.isfinite(PV1) & np.isfinite(PV2))
+    if info is not None:
+        info["tiles"] = stats
     _warn_repairs(stats)
     return (np.ascontiguousarray(PD1), np.ascontiguousarray(PD2), np.ascontiguousarray(PV1),
             np.ascontiguousarray(PV2), np.flatnonzero(bad).tolist())

@@ -93,11 +93,16 @@ def grow(vf: VertexFaces, core, k, *, close_pinches=True, max_closing=4):
         front = np.unique(verts[~seen[verts]])
         seen[front] = True
     if close_pinches:
+        # a pinched vertex has all its tile faces in the last ring (a vertex of an inner
+        # ring has its whole fan inside); faces sharing an edge differ by at most one ring,
+        # so the boundary edges of the last ring are those of the faces of rings ≥ k - 1
         for _ in range(max_closing):
-            inside = np.flatnonzero(ring >= 0)
-            E, _ = boundary_edge_faces(vf.local, inside)
+            outer = np.flatnonzero(ring >= max(int(k) - 1, 0))
+            E, _ = boundary_edge_faces(vf.local, outer)
             deg = np.bincount(E.ravel(), minlength=len(vf.vertices))
-            pinched = np.flatnonzero(deg > 2)
+            last = np.zeros(len(vf.vertices), dtype=bool)
+            last[vf.local[ring >= int(k)].ravel()] = True
+            pinched = np.flatnonzero((deg > 2) & last)
             cand = vf.faces_of(pinched)
             new = np.unique(cand[ring[cand] < 0])
             if new.size == 0:

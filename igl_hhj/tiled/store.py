@@ -36,7 +36,7 @@ ARRAYS = {"PD1": (3,), "PD2": (3,), "PV1": (), "PV2": ()}
 """The per-vertex outputs and their row shapes."""
 
 STAT_COLUMNS = ("tile", "core_faces", "faces", "vertices", "rings", "rounds", "radius_max", "boundary",
-                "rings_needed", "complete", "seconds", "warnings")
+                "rings_needed", "complete", "seconds", "peak_rss", "warnings")
 
 
 def _atomic_json(path, obj):

@@ -25,7 +25,9 @@ class GrownTile:
 
     ``faces`` (m,) global face indices (ascending), ``F`` (m, 3) local, ``vertices`` (n,)
     global vertex indices of ``V`` (n, 3), ``ring`` (m,) each face's ring (0: core),
-    ``complete``: the growth ran out of faces (no cut: the tile holds whole components)."""
+    ``real_boundary`` (n,) bool: the vertex is on a boundary edge of the mesh (not only
+    on the cut), ``band_boundary``: a face of rings 1 .. rings - 1 has a boundary edge of
+    the mesh, ``complete``: the growth ran out of faces (no cut: whole components)."""
 
     faces: np.ndarray
     F: np.ndarray
@@ -34,15 +36,24 @@ class GrownTile:
     ring: np.ndarray
     rings: int
     complete: bool
+    real_boundary: np.ndarray
+    band_boundary: bool
 
-    def band_has_boundary(self) -> bool:
-        """True when a face of rings 1 .. rings - 1 has a boundary edge (a real one: all
-        faces around such a face's vertices are in the tile)."""
-        band = np.flatnonzero((self.ring >= 1) & (self.ring < self.rings))
-        if band.size == 0:
-            return False
-        _, owner = boundary_edge_faces(self.F, np.arange(len(self.F)))
-        return bool(np.isin(owner, band).any())
+
+def _real_boundary(vf, ring, rings):
+    """Boundary edges of the tile ``ring >= 0`` that are boundary edges of the mesh: no face
+    outside the tile (all of them are loaded around the cut) shares them.  Returns the
+    (superset-local) vertices on such edges and whether a face of rings 1 .. rings - 1 has one."""
+    E, owner = boundary_edge_faces(vf.local, np.flatnonzero(ring >= 0))
+    if len(E) == 0:
+        return np.zeros(0, dtype=np.int64), False
+    n = len(vf.vertices)
+    cand = vf.faces_of(np.unique(E))
+    out = vf.local[np.unique(cand[ring[cand] < 0])]
+    OE = np.concatenate([out[:, [1, 2]], out[:, [2, 0]], out[:, [0, 1]]])
+    real = ~np.isin(E.min(axis=1) * n + E.max(axis=1), OE.min(axis=1) * n + OE.max(axis=1))
+    band = bool((real & (ring[owner] >= 1) & (ring[owner] < rings)).any())
+    return np.unique(E[real]), band
 
 
 def _margin_cells(plan, t, rings):
@@ -70,9 +81,16 @@ def grown_tile(source, plan, t, rings) -> GrownTile:
     sel = np.flatnonzero(ring >= 0)
     complete = not (ring[sel] >= rings).any() if rings > 0 else False
     used, local = np.unique(vf.local[sel], return_inverse=True)
+    real, band = _real_boundary(vf, ring, rings)
     vertices = vf.vertices[used]
     return GrownTile(faces[sel], local.reshape(-1, 3), vertices, source.vertices(vertices), ring[sel],
-                     int(rings), bool(complete))
+                     int(rings), bool(complete), np.isin(used, real), band)
+
+
+def _peak_rss():
+    """Peak resident memory of this process in bytes (Linux ``VmHWM``; 0 when unknown)."""
+    from ..batch import _proc_status_bytes
+    return _proc_status_bytes("VmHWM") or 0
 
 
 def compute_tile(source, plan, t, params):
@@ -87,17 +105,17 @@ def compute_tile(source, plan, t, params):
     rows : (k,) int64, the vertices tile t owns; values : dict of their rows
     (``PD1, PD2, PV1, PV2``); stats : dict (``tile, core_faces, faces, rings, rounds,
     radius_max`` (on the overlap), ``radius_tile_max`` (on the grown tile), ``boundary,
-    rings_needed, complete, vertices, seconds, warnings``).
+    rings_needed, complete, vertices, seconds, peak_rss`` (of the process so far), ``warnings``).
     """
     t0 = time.perf_counter()
     rings = int(params["rings"])
     for rounds in range(1, MAX_ROUNDS + 1):
         tile = grown_tile(source, plan, t, rings)
-        out = tile_values(tile.V, tile.F, params)
+        out = tile_values(tile.V, tile.F, params, real_boundary=tile.real_boundary)
         band = tile.ring >= 1
         rmax = float(out["radius"][band].max()) if band.any() else 0.0
         rall = float(out["radius"].max()) if len(out["radius"]) else 0.0
-        boundary = tile.band_has_boundary()
+        boundary = tile.band_boundary
         need = reach.overlap_rings(rmax, params["eps"], boundary=boundary)
         if params.get("fixed") or tile.complete or need <= rings:
             break
@@ -108,5 +126,5 @@ def compute_tile(source, plan, t, params):
     stats = dict(tile=int(t), core_faces=plan.tile_size(t), faces=int(len(tile.faces)), rings=rings,
                  rounds=rounds, radius_max=rmax, radius_tile_max=rall, boundary=boundary, rings_needed=need,
                  complete=tile.complete, vertices=int(len(rows)),
-                 seconds=time.perf_counter() - t0, warnings=out["warnings"])
+                 seconds=time.perf_counter() - t0, peak_rss=_peak_rss(), warnings=out["warnings"])
     return rows, values, stats
