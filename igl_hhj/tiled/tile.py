@@ -18,6 +18,19 @@ MAX_ROUNDS = 4
 """A tile is regrown at most this many times (the rule's radius is bounded, so one
 regrowth suffices unless the stage's radius grows with the overlap)."""
 
+HEADROOM = 1.25
+"""A tile is given (and regrown to) the rings of ``HEADROOM`` × the radius that sets its
+overlap, at most those of the largest radius the stage can choose: a larger overlap
+band may hold a slightly larger radius (measured: 13.26 → 13.72 between tiles of a
+jittered torus), and a regrowth costs a whole recomputation, a few more rings little."""
+
+
+def rings_for(radius, params):
+    """The rings a tile is given for a measured ``radius``: the rule's, with
+    :data:`HEADROOM` up to ``params["rings_bound"]``."""
+    need = reach.overlap_rings(radius, params["eps"])
+    return max(need, min(reach.overlap_rings(HEADROOM * radius, params["eps"]), params["rings_bound"]))
+
 
 @dataclass
 class GrownTile:
@@ -98,7 +111,8 @@ def compute_tile(source, plan, t, params):
     the radius the vertex stage chose on the overlap's faces (:func:`reach.overlap_rings`).
 
     ``params``: those of :func:`igl_hhj.tiled._compute.tile_values` and ``eps``, ``rings``
-    (the first overlap), ``fixed`` (True: keep ``rings`` whatever the stage chose).
+    (the first overlap), ``rings_bound`` (:func:`rings_for`), ``fixed`` (True: keep
+    ``rings`` whatever the stage chose).
 
     Returns
     -------
@@ -119,7 +133,7 @@ def compute_tile(source, plan, t, params):
         need = reach.overlap_rings(rmax, params["eps"], boundary=boundary)
         if params.get("fixed") or tile.complete or need <= rings:
             break
-        rings = need
+        rings = max(need, rings_for(rmax, params))
     own = plan.owners(tile.vertices) == t
     rows = tile.vertices[own]
     values = {k: np.ascontiguousarray(out[k][own]) for k in ("PD1", "PD2", "PV1", "PV2")}
