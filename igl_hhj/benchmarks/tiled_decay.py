@@ -30,8 +30,9 @@ GENERATED = ("jittered ellipsoid 82k", "noisy ellipsoid 82k", "noisy ellipsoid 3
 def _spd_solve(A):
     from ..solvers import _cholmod
     solve = _cholmod(sp.csr_matrix(A))
-    if solve is None:
-        raise RuntimeError("CHOLMOD refused a smoothing matrix")
+    if solve is None:            # CHOLMOD finds it not numerically positive definite: LU
+        import scipy.sparse.linalg as spla
+        return spla.factorized(sp.csc_matrix(A))
     return lambda b: solve(np.ascontiguousarray(b, dtype=np.float64).reshape(len(b), -1)).reshape(b.shape)
 
 
@@ -141,7 +142,7 @@ def half_space_study(V, F, radius=5, eps=EPS):
     last = int(ok[-1]) if ok.size else 0
     rate = (np.log10(max(per_s[0], 1e-300)) - np.log10(per_s[last])) / max(last, 1)
     band_boundary = bool(real_v.any())
-    rmax = float(r.max())
+    rmax = float(r[dface >= reach.hhj_rings(eps)].max())        # as igl_hhj.tiled.tile: away from the cut
     return dict(faces=len(F), depth=depth, radius_max=rmax, boundary=band_boundary,
                 hhj_decades_per_ring=float(rate), hhj_rings=int(np.argmax(per_s < eps)) if (per_s < eps).any() else None,
                 measured=measured, resolved=measured <= depth,

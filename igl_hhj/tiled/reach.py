@@ -9,23 +9,26 @@ open boundary, and the values in the core feel it through two chains of solves:
   exponentially with the graph distance.  The change of S_h caused by the cut,
   relative to the largest |S_h|, falls by at least :data:`HHJ_DECADES_PER_RING`
   decades per ring (measured: ``python -m igl_hhj.benchmarks.tiled --decay``), so
-  after ``k_S = ⌈log10(1/ε) / HHJ_DECADES_PER_RING⌉`` rings it is below ε.
+  after ``k_S = ⌈log10(A/ε) / HHJ_DECADES_PER_RING⌉`` rings a change of A × max |κ|
+  at the cut is below ε (A = :data:`CUT_AMPLITUDE`).
 * **the vertex stage's smoothing.**  ``steps × order`` implicit diffusion solves
   ``(M + t L)⁻¹ M`` with ``t = ℓ_T² / steps``, ``ℓ_T = SMOOTHING_PER_RADIUS · r_T · h_T``
   (:mod:`igl_hhj.intrinsic`; ``r_T`` the per-face radius the stage chooses).  Across
   a cut (a line source) each solve is the 1-D resolvent, whose Green's function is
   ``e^{-|x|/a} / 2a`` with ``a = √t``; the composition of ``n`` of them decays like
   the tail of a Gamma(n) law, ``Q_n(x/a) = e^{-x/a} Σ_{j<n} (x/a)^j / j!``, for a unit
-  perturbation at the cut.  The cut is therefore harmless below ε after a distance
-  ``x_n(ε) · a``, ``Q_n(x_n(ε)) = ε``; in rings, with :data:`RING_SPACING` mean edge
-  lengths per ring, ``k_L = ⌈x_n(ε) · SMOOTHING_PER_RADIUS · r_max · b / (√steps ·
-  RING_SPACING)⌉`` with ``r_max`` the largest radius on the faces between the cut and
-  the core and ``b`` :data:`igl_hhj.recovery.BOUNDARY_LENGTH_FACTOR` when those faces
+  perturbation at the cut.  A change of A × max |κ| at the cut is therefore below ε
+  after a distance ``x_n(ε/A) · a``, ``Q_n(x_n(ε/A)) = ε/A``; in rings, with
+  :data:`RING_SPACING` mean edge lengths per ring, ``k_L = ⌈x_n(ε/A) ·
+  SMOOTHING_PER_RADIUS · r_max · b / (√steps · RING_SPACING)⌉`` with ``r_max`` the largest radius on the faces between the core and
+  the ``k_S`` rings next to the cut (there the cut perturbs S_h, and with it the radius
+  the stage chooses: 6.5 instead of 1.3 on the cut's ring of an icosphere; that zone is
+  the ``k_S`` term's) and ``b`` :data:`igl_hhj.recovery.BOUNDARY_LENGTH_FACTOR` when those faces
   touch a real open boundary (the stage smooths twice as far along it), 1 otherwise.
 
-The rule is ``k = k_S + k_L`` (:func:`overlap_rings`).  Both terms bound a unit
-perturbation at the cut; the values at the cut change by less than max |κ| (measured
-0.1–0.9 of it), so the rule is conservative there.  Its inputs follow the stage: the
+The rule is ``k = k_S + k_L`` (:func:`overlap_rings`).  Both terms bound a
+perturbation of :data:`CUT_AMPLITUDE` × max |κ| at the cut (measured: at most 2.6).
+Its inputs follow the stage: the
 constants are read from :mod:`igl_hhj.intrinsic` and :mod:`igl_hhj.recovery`, and the
 radius is the one the stage reports for each tile (:func:`igl_hhj.tiled.runner`
 regrows a tile whose reported radius needs more rings than it was given).
@@ -45,6 +48,11 @@ HHJ_DECADES_PER_RING = 0.4
 solves, half-space cuts; ``python -m igl_hhj.benchmarks.tiled --decay``): 0.86–0.89 on
 jittered and noisy ellipsoids, 0.5–1.4 on real meshes, 0.40 on ``beetle.off`` (a scan
 with slivers, the slowest of the 15 measured)."""
+
+CUT_AMPLITUDE = 10.0
+"""The largest change at the cut the rule allows for, in units of max |κ|: both terms
+bound a perturbation of this size (measured at the cut: 0.03 × max |κ| on a jittered
+ellipsoid, 1.3 on noisy ellipsoids, 2.6 on a noisy open scan with slivers)."""
 
 RING_SPACING = math.sqrt(3.0) / 2.0
 """Distance gained per vertex ring, in mean edge lengths: the row height of a
@@ -75,7 +83,7 @@ def gamma_tail_root(n: int, eps: float) -> float:
 
 def hhj_rings(eps: float = DEFAULT_TOLERANCE) -> int:
     """Rings after which the cut changes S_h by less than ``eps`` (relative)."""
-    return math.ceil(math.log10(1.0 / eps) / HHJ_DECADES_PER_RING)
+    return math.ceil(math.log10(CUT_AMPLITUDE / eps) / HHJ_DECADES_PER_RING)
 
 
 def smoothing_rings(radius: float, eps: float = DEFAULT_TOLERANCE, *, boundary: bool = False) -> int:
@@ -91,7 +99,7 @@ def smoothing_rings(radius: float, eps: float = DEFAULT_TOLERANCE, *, boundary: 
     a = SMOOTHING_PER_RADIUS * float(radius) / math.sqrt(SMOOTHING_STEPS)   # √t in mean edge lengths
     if boundary:
         a *= BOUNDARY_LENGTH_FACTOR
-    return math.ceil(gamma_tail_root(n, eps) * a / RING_SPACING)
+    return math.ceil(gamma_tail_root(n, eps / CUT_AMPLITUDE) * a / RING_SPACING)
 
 
 def overlap_rings(radius: float, eps: float = DEFAULT_TOLERANCE, *, boundary: bool = False) -> int:
@@ -111,7 +119,7 @@ def overlap_rings(radius: float, eps: float = DEFAULT_TOLERANCE, *, boundary: bo
     --------
     >>> from igl_hhj.tiled.reach import overlap_rings
     >>> overlap_rings(1.0), overlap_rings(5.0), overlap_rings(25.0)
-    (19, 33, 103)
+    (22, 38, 116)
     """
     return hhj_rings(eps) + smoothing_rings(radius, eps, boundary=boundary)
 

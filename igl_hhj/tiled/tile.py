@@ -126,9 +126,13 @@ def compute_tile(source, plan, t, params):
     for rounds in range(1, MAX_ROUNDS + 1):
         tile = grown_tile(source, plan, t, rings)
         out = tile_values(tile.V, tile.F, params, real_boundary=tile.real_boundary)
-        band = tile.ring >= 1
+        # the radius the stage chose, away from the cut: within the rule's k_S outermost
+        # rings the cut perturbs S_h and hence the radius itself (icosphere(7): 1.3 in
+        # the tile, 6.5 on the cut's ring), a perturbation the k_S rings already cover
+        inner = tile.ring <= rings - reach.hhj_rings(params["eps"])
+        band = inner & (tile.ring >= 1)
         rmax = float(out["radius"][band].max()) if band.any() else 0.0
-        rall = float(out["radius"].max()) if len(out["radius"]) else 0.0
+        rall = float(out["radius"][inner].max()) if inner.any() else 0.0
         boundary = tile.band_boundary
         need = reach.overlap_rings(rmax, params["eps"], boundary=boundary)
         if params.get("fixed") or tile.complete or need <= rings:
