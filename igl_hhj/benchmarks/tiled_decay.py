@@ -142,7 +142,8 @@ def half_space_study(V, F, radius=5, eps=EPS):
     last = int(ok[-1]) if ok.size else 0
     rate = (np.log10(max(per_s[0], 1e-300)) - np.log10(per_s[last])) / max(last, 1)
     band_boundary = bool(real_v.any())
-    rmax = float(r[dface >= reach.hhj_rings(eps)].max())        # as igl_hhj.tiled.tile: away from the cut
+    away = dface >= reach.hhj_rings(eps)                          # as igl_hhj.tiled.tile: away from the cut
+    rmax = float(r[away].max() if away.any() else r.max())
     return dict(faces=len(F), depth=depth, radius_max=rmax, boundary=band_boundary,
                 hhj_decades_per_ring=float(rate), hhj_rings=int(np.argmax(per_s < eps)) if (per_s < eps).any() else None,
                 measured=measured, resolved=measured <= depth,
@@ -175,13 +176,17 @@ def generated(name):
 
 
 def decay_table(names=None, mesh_dir=None, progress=True):
-    """Rows of :func:`half_space_study` for generated meshes and every mesh of ``mesh_dir``."""
+    """Rows of :func:`half_space_study`: for ``names`` (generated meshes of :data:`GENERATED`
+    and mesh files), or, without names, the generated meshes and every mesh of ``mesh_dir``."""
     import igl
     import sys
-    cases = [(n, lambda n=n: generated(n)) for n in (names or GENERATED) if n in GENERATED]
-    paths = [Path(n) for n in (names or []) if n not in GENERATED]
-    if not names and mesh_dir is not None:
-        paths = sorted([*Path(mesh_dir).glob("*.off"), *Path(mesh_dir).glob("*.obj")])
+    if names:
+        gen = [n for n in names if n in GENERATED]
+        paths = [Path(n) for n in names if n not in GENERATED]
+    else:                                   # everything: the generated meshes and mesh_dir's
+        gen = list(GENERATED)
+        paths = sorted([*Path(mesh_dir).glob("*.off"), *Path(mesh_dir).glob("*.obj")]) if mesh_dir else []
+    cases = [(n, lambda n=n: generated(n)) for n in gen]
     cases += [(p.name, lambda p=p: igl.read_triangle_mesh(str(p))) for p in paths]
     rows = []
     for name, load in cases:
@@ -206,7 +211,7 @@ def markdown(rows):
             out.append(f"| {r['mesh']} | {r['faces']} | | | | | {r['error']} | | |")
             continue
         meas = f"{r['measured']}" if r["resolved"] else f"> {r['depth']}"
-        ok = "yes" if r["measured"] <= r["rule"] else ("?" if not r["resolved"] else "NO")
+        ok = ("yes" if r["measured"] <= r["rule"] else "NO") if r["resolved"] else "– (too few rings)"
         out.append(f"| {r['mesh']} | {r['faces']:,} | {r['depth']} | {r['cut_change']:.1e} | "
                    f"{r['hhj_decades_per_ring']:.2f} | {r['radius_max']:.1f}{' (b)' if r['boundary'] else ''} | "
                    f"{meas} | {r['rule']} | {ok} |")

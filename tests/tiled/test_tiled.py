@@ -320,3 +320,25 @@ def test_overlap_rule():
     assert reach.radius_bound(5) == 25.0
     x = reach.gamma_tail_root(4, 1e-6)
     assert abs(np.exp(-x) * (1 + x + x * x / 2 + x ** 3 / 6) - 1e-6) < 1e-12
+
+
+# --------------------------------------------------------------------------- command line
+@pytest.mark.slow
+def test_cli_tile_faces(tmp_path, capsys):
+    from igl_hhj import cli
+    V, F = _ellipsoid(1)
+    mesh = _ply(tmp_path, V, F)
+    assert cli.main(["curvature", str(mesh), "-o", str(tmp_path / "out"), "--tile-faces", "1500",
+                     "--workers", "0"]) == 0
+    said = capsys.readouterr().out
+    assert "tiles computed" in said and "PV1.npy" in said
+    ref = tiled.principal_curvature(V, F, tile_faces=1500, workers=0)
+    for a, b in zip(tiled.read_result(tmp_path / "out"), ref):
+        assert np.array_equal(a, b)
+    for extra, match in ((["--per", "face"], "--per cannot be used"), ([], "needs -o OUT")):
+        args = ["curvature", str(mesh), "--tile-faces", "1500", *extra]
+        if extra:
+            args += ["-o", str(tmp_path / "o2")]
+        assert cli.main(args) == 2
+        assert match in capsys.readouterr().err
+    assert cli.main(["curvature", str(tmp_path / "nope.ply"), "-o", str(tmp_path / "o3"), "--tile-faces", "9"]) == 3
