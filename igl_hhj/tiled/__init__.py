@@ -119,7 +119,7 @@ def curvature_file(mesh_path, out_path, *, radius: float = 5, tile_faces: int = 
         Rings of overlap; default: the rule of :mod:`igl_hhj.tiled.reach` at ``eps``, from
         the radius the vertex stage chose on each tile.
     eps : float
-        Tolerance of the rule: the cut changes a value by at most ``eps`` × max |κ|.
+        Tolerance of the rule: the cut changes a value by at most ``eps`` × max(abs(κ)).
     client, scheduler, workers
         A ``distributed.Client``, a scheduler address (``tcp://host:port``; workers must
         see ``mesh_path`` and ``out_path``), or the number of worker processes of the
@@ -172,7 +172,7 @@ def principal_curvature(V: Any, F: Any = None, radius: float = 5, useKring: bool
                         workdir: str | None = None, info: dict | None = None):
     """:func:`igl_hhj.principal_curvature` computed tile by tile (same call, same returns).
 
-    Every vertex's values equal the whole-mesh call's to ``eps`` × max |κ| plus the
+    Every vertex's values equal the whole-mesh call's to ``eps`` × max(abs(κ)) plus the
     solvers' tolerances (``rtol``; ``igl_hhj/docs/tiled.md``), the same ``bad_vertices``,
     the same repairs (one :class:`igl_hhj.mesh.MeshWarning` for the tiles that needed one).
 

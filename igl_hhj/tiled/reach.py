@@ -9,7 +9,7 @@ open boundary, and the values in the core feel it through two chains of solves:
   exponentially with the graph distance.  The change of S_h caused by the cut,
   relative to the largest |S_h|, falls by at least :data:`HHJ_DECADES_PER_RING`
   decades per ring (measured: ``python -m igl_hhj.benchmarks.tiled --decay``), so
-  after ``k_S = ⌈log10(A/ε) / HHJ_DECADES_PER_RING⌉`` rings a change of A × max |κ|
+  after ``k_S = ⌈log10(A/ε) / HHJ_DECADES_PER_RING⌉`` rings a change of A × max(abs(κ))
   at the cut is below ε (A = :data:`CUT_AMPLITUDE`).
 * **the vertex stage's smoothing.**  ``steps × order`` implicit diffusion solves
   ``(M + t L)⁻¹ M`` with ``t = ℓ_T² / steps``, ``ℓ_T = SMOOTHING_PER_RADIUS · r_T · h_T``
@@ -17,7 +17,7 @@ open boundary, and the values in the core feel it through two chains of solves:
   a cut (a line source) each solve is the 1-D resolvent, whose Green's function is
   ``e^{-|x|/a} / 2a`` with ``a = √t``; the composition of ``n`` of them decays like
   the tail of a Gamma(n) law, ``Q_n(x/a) = e^{-x/a} Σ_{j<n} (x/a)^j / j!``, for a unit
-  perturbation at the cut.  A change of A × max |κ| at the cut is therefore below ε
+  perturbation at the cut.  A change of A × max(abs(κ)) at the cut is therefore below ε
   after a distance ``x_n(ε/A) · a``, ``Q_n(x_n(ε/A)) = ε/A``; in rings, with
   :data:`RING_SPACING` mean edge lengths per ring, ``k_L = ⌈x_n(ε/A) ·
   SMOOTHING_PER_RADIUS · r_max · b / (√steps · RING_SPACING)⌉`` with ``r_max`` the largest radius on the faces between the core and
@@ -27,7 +27,7 @@ open boundary, and the values in the core feel it through two chains of solves:
   touch a real open boundary (the stage smooths twice as far along it), 1 otherwise.
 
 The rule is ``k = k_S + k_L`` (:func:`overlap_rings`).  Both terms bound a
-perturbation of :data:`CUT_AMPLITUDE` × max |κ| at the cut (measured: at most 2.6).
+perturbation of :data:`CUT_AMPLITUDE` × max(abs(κ)) at the cut (measured: at most 2.6).
 Its inputs follow the stage: the
 constants are read from :mod:`igl_hhj.intrinsic` and :mod:`igl_hhj.recovery`, and the
 radius is the one the stage reports for each tile (:func:`igl_hhj.tiled.runner`
@@ -41,7 +41,7 @@ __all__ = ["overlap_rings", "radius_bound", "hhj_rings", "smoothing_rings", "gam
            "HHJ_DECADES_PER_RING", "RING_SPACING", "DEFAULT_TOLERANCE"]
 
 DEFAULT_TOLERANCE = 1e-6
-"""Default ε: the cut changes a core value by at most ε · max |κ| (solver tolerances aside)."""
+"""Default ε: the cut changes a core value by at most ε · max(abs(κ)) (solver tolerances aside)."""
 
 HHJ_DECADES_PER_RING = 0.4
 """Slowest measured decay of the cut's effect on S_h, in decades per vertex ring (direct
@@ -50,8 +50,8 @@ jittered and noisy ellipsoids, 0.5–1.4 on real meshes, 0.40 on ``beetle.off`` 
 with slivers, the slowest of the 15 measured)."""
 
 CUT_AMPLITUDE = 10.0
-"""The largest change at the cut the rule allows for, in units of max |κ|: both terms
-bound a perturbation of this size (measured at the cut: 0.03 × max |κ| on a jittered
+"""The largest change at the cut the rule allows for, in units of max(abs(κ)): both terms
+bound a perturbation of this size (measured at the cut: 0.03 × max(abs(κ)) on a jittered
 ellipsoid, 1.3 on noisy ellipsoids, 2.6 on a noisy open scan with slivers)."""
 
 RING_SPACING = math.sqrt(3.0) / 2.0
@@ -104,7 +104,7 @@ def smoothing_rings(radius: float, eps: float = DEFAULT_TOLERANCE, *, boundary: 
 
 def overlap_rings(radius: float, eps: float = DEFAULT_TOLERANCE, *, boundary: bool = False) -> int:
     """The overlap rule ``k = k_S + k_L`` (module docstring): rings of overlap after which
-    the cut changes a core value by less than ``eps`` times max |κ|.
+    the cut changes a core value by less than ``eps`` times max(abs(κ)).
 
     Parameters
     ----------
