@@ -85,11 +85,7 @@ def _on_mesh(mesh, params, real_boundary=None):
                               estimated=treatment == "estimate")]
     X, N, r = _vertex_stage(mesh, holder, params["radius"], rtol, real_boundary)
     PD1, PD2, PV1, PV2 = kernels.principal_hz(X, N)
-    del X
-    ref = mesh.referenced_vertices
-    if not ref.all():
-        for A in (PD1, PD2, PV1, PV2):
-            A[~ref] = np.nan
+    del X                                    # NaN rows: unreferenced, no tangent plane
     return (*mark_bad_vertices(mesh, PD1, PD2, PV1, PV2, copy=False), r)
 
 
