@@ -4,10 +4,12 @@ default, a running cluster by address), with retries, a progress bar and resume.
 Order of work
 -------------
 1. the plan (:func:`igl_hhj.tiled.partition.plan_tiles`), kept in ``OUT/.work``;
-2. the **pilots**: tiles 0 and 1 (:data:`PILOTS`) with the overlap of the largest
-   radius the vertex stage can choose (:func:`igl_hhj.tiled.reach.radius_bound`); the
-   largest radius they actually chose on their grown tiles sets the first overlap of
-   every other tile (:func:`igl_hhj.tiled.tile.rings_for`);
+2. the **pilots**: tiles 0 and 1 (:data:`PILOTS`) with the overlap of the caller's
+   radius (the stage's nominal scale), regrown like any tile when the radius the stage
+   chose needs more (at most the rings of the largest radius it can choose,
+   :func:`igl_hhj.tiled.reach.radius_bound`); the largest radius they chose on their
+   grown tiles sets the first overlap of every other tile
+   (:func:`igl_hhj.tiled.tile.rings_for`);
 3. the other tiles, each regrown by :func:`igl_hhj.tiled.tile.compute_tile` if the
    radius its vertex stage chose needs more rings.
 
@@ -30,8 +32,8 @@ from .store import FileStore
 from .tile import compute_tile, rings_for
 
 PILOTS = 2
-"""Tiles computed first, with the overlap of the largest radius the vertex stage can
-choose; the largest radius they chose sets the other tiles' first overlap.  Two, so
+"""Tiles computed first; the largest radius their vertex stage chose sets the other
+tiles' first overlap.  Two, so
 that the two workers of a small machine both work meanwhile; a constant, so that every
 tile's overlap (and so its bits) does not depend on the number of workers."""
 
@@ -173,7 +175,8 @@ def run_tiles(source, plan, store, params, *, client=None, retries=2, progress=N
             run([t for t in range(plan.n_tiles) if t not in stats], p)
         else:
             bound = reach.overlap_rings(reach.radius_bound(params["radius"]), params["eps"])
-            p = dict(params, rings=bound, rings_bound=bound, fixed=False)
+            p = dict(params, rings_bound=bound, fixed=False)
+            p["rings"] = rings_for(params["radius"], p)
             pilots = list(range(min(PILOTS, plan.n_tiles)))
             run([t for t in pilots if t not in stats], p)
             first = rings_for(max(stats[t]["radius_tile_max"] for t in pilots), p)
