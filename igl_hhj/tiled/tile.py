@@ -135,6 +135,8 @@ def compute_tile(source, plan, t, params):
         rall = float(out["radius"][inner].max()) if inner.any() else 0.0
         boundary = tile.band_boundary
         need = reach.overlap_rings(rmax, params["eps"], boundary=boundary)
+        if not band.any():          # no face away from the cut: the radius was not seen yet
+            need = max(need, reach.hhj_rings(params["eps"]) + 1)
         if params.get("fixed") or tile.complete or need <= rings:
             break
         rings = max(need, rings_for(rmax, params))

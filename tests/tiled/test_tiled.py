@@ -263,8 +263,8 @@ def test_loopback_cluster_equals_in_process(loopback_cluster, tmp_path):
     address, _ = loopback_cluster
     V, F = _ellipsoid(1)
     mesh = _ply(tmp_path, V, F)
-    a = tiled.curvature_file(mesh, tmp_path / "dask", tile_faces=1500, scheduler=address, overlap=3)
-    b = tiled.curvature_file(mesh, tmp_path / "local", tile_faces=1500, workers=0, overlap=3)
+    a = tiled.curvature_file(mesh, tmp_path / "dask", tile_faces=1500, scheduler=address)
+    b = tiled.curvature_file(mesh, tmp_path / "local", tile_faces=1500, workers=0)
     assert len(a.computed) == len(a.stats) >= 4
     for x, y in zip(tiled.read_result(a.out), tiled.read_result(b.out)):
         assert np.array_equal(x, y)
@@ -311,6 +311,25 @@ def test_missing_file_and_unfinished_output(tmp_path):
         tiled.curvature_file(tmp_path / "nope.ply", tmp_path / "out", workers=0)
     with pytest.raises(ValueError, match="not a finished"):
         tiled.read_result(tmp_path)
+
+
+@pytest.mark.slow
+def test_a_tile_given_too_few_rings_is_regrown():
+    """The radius the vertex stage chose decides: a tile started with 2 rings is regrown to the
+    rule's rings for it (or until it holds whole components)."""
+    import tempfile
+    from igl_hhj.tiled.partition import plan_tiles
+    from igl_hhj.tiled.source import ArraySource
+    from igl_hhj.tiled.tile import compute_tile
+    V, F = _ellipsoid(3)
+    src = ArraySource(V, F)
+    with tempfile.TemporaryDirectory() as d:
+        plan = plan_tiles(src, d, 10000)
+        params = dict(radius=5.0, rtol=1e-6, solver="auto", boundary="estimate", eps=1e-6, rings=2,
+                      rings_bound=reach.overlap_rings(25.0), fixed=False)
+        _, _, st = compute_tile(src, plan, 3, params)
+    assert st["rounds"] >= 2 and st["radius_max"] > 1.0
+    assert st["complete"] or st["rings"] >= reach.overlap_rings(st["radius_max"]) > 2
 
 
 def test_overlap_rule():
