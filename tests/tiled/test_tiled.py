@@ -130,10 +130,11 @@ def _ply(tmp_path, V, F, name="m.ply"):
     return p
 
 
-def test_curvature_file_equals_in_memory_and_reads_back(tmp_path):
+def test_curvature_file_equals_in_memory_and_reads_back(tmp_path, capsys):
     V, F = _ellipsoid(1)
     res = tiled.curvature_file(_ply(tmp_path, V, F), tmp_path / "out", tile_faces=1500, workers=0,
-                               overlap=3)
+                               overlap=3, progress=True)
+    assert capsys.readouterr().err.count("faces computed for") == len(res.stats)     # not a terminal: lines
     assert res.read == "memory-mapped" and len(res.stats) >= 4 and res.n_faces == len(F)
     PD1, PD2, PV1, PV2, bad = tiled.read_result(tmp_path / "out")
     assert isinstance(PV1, np.memmap)
