@@ -43,16 +43,15 @@ open meshes it runs but its boundary values are wrong.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 import scipy.sparse as sp
 
 from .curvature import check_principal_curvature_args, vertex_principal_curvature
 from .solvers import DEFAULT_RTOL
 from .mesh import as_mesh, mark_bad_vertices
+from .results import CurvatureEstimate
 
 __all__ = [
     "CurvatureEstimate", "ESTIMATORS", "estimate",
@@ -62,40 +61,6 @@ __all__ = [
     "heine_curvature_vector", "heine_weingarten_map", "heine",
     "pymeshlab_principal_curvature", "PYMESHLAB_METHODS",
 ]
-
-
-@dataclass(frozen=True)
-class CurvatureEstimate:
-    """Curvatures of one estimator, at vertices or at faces.
-
-    Attributes
-    ----------
-    location : {"vertex", "face"}
-        Where the values live; n = #V or #F.
-    k1, k2 : (n,) float64
-        Principal curvatures, ``k1 ≥ k2`` (NaN where undefined).
-    H : (n,) float64
-        Mean curvature ``(κ1 + κ2)/2`` as the estimator defines it.
-    K : (n,) float64
-        Gauss curvature as the estimator defines it.
-    d1, d2 : (n, 3) float64 or None
-        Unit principal directions of k1 and k2; None if the method has none.
-    bad : (m,) int64
-        Indices (vertices or faces) without a meaningful value (NaN rows or
-        rows libigl flags / zeroes).
-    name : str
-        Estimator name.
-    """
-
-    location: str
-    k1: NDArray[np.float64]
-    k2: NDArray[np.float64]
-    H: NDArray[np.float64]
-    K: NDArray[np.float64]
-    d1: NDArray[np.float64] | None
-    d2: NDArray[np.float64] | None
-    bad: NDArray[np.int64]
-    name: str = ""
 
 
 def _ordered(name, location, k1, k2, H, K, d1, d2, bad):

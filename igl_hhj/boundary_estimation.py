@@ -1,6 +1,6 @@
 """Data-free boundary conditions for the HHJ shape operator: O(h²) boundary normals.
 
-Walker's clamped boundary condition (paper 000, eq. 5.19, the Σ_c term
+Walker's clamped boundary condition (Walker 2023, eq. 5.19, the Σ_c term
 ``∫_∂Γ n·ξ``) needs the true surface normal ν~ along the boundary; his
 Theorem 5.3 gives O(h) for S_h when ν~ is accurate to O(h²) (the nodal
 interpolant of the exact normal).  Without data, the *plain assembly* (face
@@ -20,22 +20,11 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from .constants import BOUNDARY_TREATMENTS, FIT_RINGS, SIDE_DOT_MIN
 from .mesh import TriangleMesh
 
 __all__ = ["estimate_boundary_normals", "boundary_normal_fits_reference", "BOUNDARY_TREATMENTS"]
 
-BOUNDARY_TREATMENTS = ("estimate", "plain")
-"""``boundary=`` values: "estimate" (clamped with :func:`estimate_boundary_normals`,
-the default without boundary data) and "plain" (Walker's plain assembly: the face
-normal stands in for the boundary normal)."""
-
-
-FIT_RINGS = 3
-"""Default fit neighbourhood of :func:`estimate_boundary_normals` in rings."""
-
-SIDE_DOT_MIN = 0.05
-"""An estimated boundary normal must have ``N·ν_T > SIDE_DOT_MIN`` with every boundary
-face T of the vertex (else the faces' mean normal, else none)."""
 
 
 def _dot3(a, b):

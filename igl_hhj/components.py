@@ -1,5 +1,5 @@
 """Connected components: solve each one on its own, so that no component's result
-depends on another's (issue 23, "locality").
+depends on another's.
 
 The HHJ system of a mesh with several connected components is block diagonal, but
 an iterative solve of all blocks together shares its CG scalars and its stopping
@@ -19,6 +19,7 @@ import warnings
 
 import numpy as np
 
+from .constants import AUTO_DIRECT_MAX
 from .mesh import TriangleMesh
 
 __all__ = ["solve_groups", "submesh", "split_parts"]
@@ -35,7 +36,6 @@ def solve_groups(mesh: TriangleMesh, solver):
     if solver == "direct" or mesh.n_faces == 0:
         return None
     from . import kernels
-    from .solvers import AUTO_DIRECT_MAX
     labels, n = kernels.vertex_components(mesh)
     if n <= 1:
         return None

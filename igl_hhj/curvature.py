@@ -1,6 +1,9 @@
 """Public curvature API: Walker's HHJ shape operator, the HHJ surface Hessian,
 per-face curvatures, and the drop-in ``principal_curvature``.
 
+The functions here check their arguments and hold the documentation; the drop-in and the
+shape operator run as one sequence in :mod:`igl_hhj.pipeline`.
+
 Sign convention (libigl's and Walker's): with outward normals (F oriented so
 that ``(x1 - x0) × (x2 - x0)`` points out), a sphere of radius R has shape
 operator ``P / R`` and principal curvatures ``+1/R``.
@@ -9,19 +12,21 @@ from __future__ import annotations
 
 from typing import Any, Literal, overload
 
-import igl  # noqa: F401  (imported with the public API, not inside the first call: issue 16)
+import igl  # noqa: F401  (imported with the public API, not inside the first call: its first call costs as the later ones)
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import kernels
-from . import components as _components
 from . import intrinsic as _intrinsic
+from . import kernels, pipeline
 from . import recovery as _recovery
-from . import small_mesh as _small_mesh
-from .boundary_estimation import BOUNDARY_TREATMENTS, estimate_boundary_normals
-from .hhj import HHJProjection, clamped_load
-from .mesh import MeshDefectError, _as_array, as_mesh, mark_bad_vertices, per_vertex_array
-from .solvers import DEFAULT_RTOL, HHJSystem
+from .boundary import check_boundary, check_magnitude, clamped_load, data_rows
+from .constants import DEFAULT_RTOL
+from .mesh import MeshDefectError, _as_array, as_mesh, per_vertex_array
+from .repair import face_values_to_caller
+from .solvers import HHJSystem
+# the pipeline's entry points, named here as before
+from .pipeline import check_principal_curvature_args, dropin_on_mesh, dropin_vertex_values  # noqa: F401
+from .pipeline import face_shape_operator as _shape_operator  # noqa: F401 (the benchmarks' name)
 
 __all__ = [
     "shape_operator", "surface_hessian", "principal_curvature",
@@ -30,65 +35,6 @@ __all__ = [
     "check_principal_curvature_args", "boundary_treatment", "smoothed_face_shape_operator",
     "dropin_vertex_values", "dropin_on_mesh", "curvature_of", "CURVATURE_KINDS", "CURVATURE_KIND_ALIASES", "CURVATURE_PER",
 ]
-
-
-# --------------------------------------------------------------------------- helpers
-def _simply_supported_mask(edges, n_points, boundary_normals, boundary_shape_operator,
-                           simply_supported, points="#V"):
-    """(len(edges),) bool: which boundary ``edges`` (pairs of point indices) are simply
-    supported, from the boundary arguments of :func:`shape_operator` (also used by
-    :func:`igl_hhj.curved.shape_operator`, whose points are the ``#N`` nodes)."""
-    if simply_supported is not None:
-        if boundary_shape_operator is None:
-            raise ValueError("simply_supported needs boundary_shape_operator (the data on those edges)")
-        flag = _as_array(simply_supported, "simply_supported")   # a mask is refused, not dropped
-        if flag.shape != (n_points,):
-            raise ValueError(f"simply_supported must have shape ({n_points},), got {flag.shape}")
-        if flag.dtype != bool:
-            raise TypeError(f"simply_supported must be a boolean array, got dtype {flag.dtype}")
-        return flag[edges[:, 0]] & flag[edges[:, 1]]
-    if boundary_shape_operator is not None:
-        if boundary_normals is not None:
-            raise ValueError("both boundary_normals and boundary_shape_operator given: pass "
-                             f"simply_supported ({points} bool) to say which boundary edges are simply supported")
-        return np.ones(len(edges), dtype=bool)
-    return np.zeros(len(edges), dtype=bool)
-
-
-def _boundary_partition(mesh, boundary_normals, boundary_shape_operator, simply_supported,
-                        estimated=False):
-    """Return (clamped_with_data (#E,) bool, simply_supported_edges (#E,) bool).
-
-    ``estimated``: the normals come from :func:`estimate_boundary_normals`, whose NaN
-    rows mark vertices without a usable normal; their edges keep the plain assembly."""
-    bnd = mesh.boundary_edges
-    ss_edges = bnd & _simply_supported_mask(mesh.edges, mesh.n_vertices, boundary_normals,
-                                            boundary_shape_operator, simply_supported)
-    clamped = bnd & ~ss_edges if boundary_normals is not None else np.zeros_like(bnd)
-    if estimated:
-        usable = np.isfinite(boundary_normals).all(axis=1)
-        clamped &= usable[mesh.edges[:, 0]] & usable[mesh.edges[:, 1]]
-    return clamped, ss_edges
-
-
-def _check_boundary(boundary):
-    if not isinstance(boundary, str) or boundary not in BOUNDARY_TREATMENTS:
-        raise ValueError(f"boundary must be one of {BOUNDARY_TREATMENTS}, got {boundary!r}")
-
-
-def _resolve_boundary(mesh, boundary, boundary_normals, boundary_shape_operator):
-    """Boundary data to use: the caller's, or (``boundary="estimate"``, an open mesh and
-    no data) the O(h²) normals of :func:`igl_hhj.boundary_estimation.estimate_boundary_normals`
-    as clamped data.  Returns ``(boundary_normals, treatment)``, treatment one of
-    "none" (closed), "data", "estimate", "plain"."""
-    _check_boundary(boundary)
-    if not mesh.has_boundary:
-        return boundary_normals, "none"
-    if boundary_normals is not None or boundary_shape_operator is not None:
-        return boundary_normals, "data"
-    if boundary == "plain":
-        return None, "plain"
-    return estimate_boundary_normals(mesh), "estimate"
 
 
 def boundary_treatment(V: Any, F: ArrayLike | None, *, boundary: str = "estimate",
@@ -102,7 +48,7 @@ def boundary_treatment(V: Any, F: ArrayLike | None, *, boundary: str = "estimate
         (clamped with estimated O(h²) normals) or "plain" (plain assembly).
     """
     mesh = as_mesh(V, F)
-    _check_boundary(boundary)
+    check_boundary(boundary)
     if not mesh.has_boundary:
         return "none"
     if boundary_normals is not None or boundary_shape_operator is not None:
@@ -110,196 +56,6 @@ def boundary_treatment(V: Any, F: ArrayLike | None, *, boundary: str = "estimate
     return boundary
 
 
-def _data_rows(mesh, A, edge_mask, name):
-    """Check that per-vertex data is finite on the endpoints of the masked edges."""
-    verts = np.unique(mesh.edges[edge_mask].ravel())
-    bad = ~np.isfinite(A[verts].reshape(len(verts), -1)).all(axis=1)
-    if bad.any():
-        raise ValueError(f"{name} is NaN or inf at boundary vertex {int(verts[bad][0])}, "
-                         "where it is needed")
-    _check_magnitude(A[verts], verts, name)
-    return verts
-
-
-def _check_magnitude(A, rows, name):
-    """Data beyond COORDINATE_MAX would overflow the solver's squared norms (silent NaN)."""
-    from .mesh import COORDINATE_MAX
-    big = (np.abs(A.reshape(len(A), -1)) > COORDINATE_MAX).any(axis=1)
-    if big.any():
-        raise ValueError(f"{name} has values beyond {COORDINATE_MAX:g} (they would overflow "
-                         f"float64 in the solver); first at vertex {int(rows[big][0])}: rescale")
-
-
-def _boundary_face_and_conormal(mesh, e):
-    f = mesh.edge_faces[e, 0]
-    i = mesh.edge_local_index[e, 0]
-    neg = f < 0
-    f = np.where(neg, mesh.edge_faces[e, 1], f)
-    i = np.where(neg, mesh.edge_local_index[e, 1], i)
-    return f, mesh.conormals_at(f, i)
-
-
-def _normalised_boundary_normals(mesh, boundary_normals, clamped, estimated=False):
-    """The boundary normals on the clamped edges' vertices scaled to unit length, after the
-    checks of the caller's data (finite, bounded, non-zero, on the side of F's normals).
-    ``estimated``: the normals of :func:`estimate_boundary_normals`, which pass every
-    check by construction (unit, NaN rows dropped by :func:`_boundary_partition`, at
-    least ``SIDE_DOT_MIN`` with every boundary face): only scaled."""
-    if estimated:            # every finite row (a superset of the clamped edges' vertices)
-        N = np.array(boundary_normals, dtype=np.float64)
-        verts = np.flatnonzero(np.isfinite(N).all(axis=1))
-        N[verts] /= np.linalg.norm(N[verts], axis=1)[:, None]
-        return N
-    N = per_vertex_array(mesh, boundary_normals, "boundary_normals", (3,))
-    verts = _data_rows(mesh, N, clamped, "boundary_normals")
-    norm = np.linalg.norm(N[verts], axis=1)
-    if (norm < 1e-12).any():
-        raise ValueError(f"boundary_normals has a zero vector at vertex {int(verts[norm < 1e-12][0])}")
-    N = N.copy()
-    N[verts] /= norm[:, None]
-    # Orientation check: the data must point to the same side as the faces.
-    e = np.flatnonzero(clamped)
-    f, _ = _boundary_face_and_conormal(mesh, e)
-    for col in (0, 1):
-        v = mesh.edges[e, col]
-        dots = np.einsum("ma,ma->m", N[v], mesh.face_normals[f])
-        if (dots <= 0).any():
-            j = int(np.flatnonzero(dots <= 0)[0])
-            raise ValueError(
-                f"boundary_normals at vertex {int(v[j])} points away from the normal of its "
-                f"boundary face {int(f[j])} (dot {dots[j]:.3f}): normals must agree with F's orientation")
-    return N
-
-
-def _simply_supported_values(mesh, boundary_shape_operator, ss_edges):
-    """ρ_e^k = -ν_T^k · mean_e(nᵀ S~ n), eq. (5.18) with P1-interpolated S~. Returns (#E, 3)."""
-    S = per_vertex_array(mesh, boundary_shape_operator, "boundary_shape_operator", (3, 3))
-    v = _data_rows(mesh, S, ss_edges, "boundary_shape_operator")
-    asym = np.abs(S[v] - S[v].transpose(0, 2, 1)).max(axis=(1, 2)) > 1e-8 * (1 + np.abs(S[v]).max(axis=(1, 2)))
-    if asym.any():                  # a shape operator is symmetric; only nᵀ S n would be used
-        raise ValueError(f"boundary_shape_operator is not symmetric at boundary vertex {int(v[asym][0])}")
-    rho = np.zeros((mesh.n_edges, 3))
-    e = np.flatnonzero(ss_edges)
-    f, n = _boundary_face_and_conormal(mesh, e)
-    Sm = 0.5 * (S[mesh.edges[e, 0]] + S[mesh.edges[e, 1]])
-    kn = np.einsum("ma,mab,mb->m", n, Sm, n)
-    rho[e] = -mesh.face_normals[f] * kn[:, None]
-    return rho
-
-
-def _boundary_rhs(mesh, rhs, clamped, N):
-    """Boundary rows of ``-B X + g`` in place: plain assembly on boundary edges without
-    data (``g_e = l_e n·∇_T X`` cancels B's one-sided term, so the row is 0) and
-    Walker's clamped load (eq. 5.19's Σ_c term) on the clamped ones, with the
-    normalised boundary normals ``N`` (#V, 3)."""
-    bnd = mesh.boundary_edges
-    if not bnd.any():
-        return rhs
-    rhs[bnd & ~clamped] = 0.0
-    if clamped.any():
-        # ξ^k = ∇_Γ id^k = P e_k, P = I - ν~ ⊗ ν~: gradients of the 3 coordinates; only the
-        # clamped edges' vertices are read (N is finite there), rows without N are zero
-        with np.errstate(over="ignore", invalid="ignore"):    # unread rows may be anything
-            P = np.eye(3)[None] - N[:, :, None] * N[:, None, :]  # (#V, 3, 3): row k = ξ^k
-        P[~np.isfinite(P)] = 0.0
-        rhs[clamped] += clamped_load(mesh, clamped, P)[clamped]
-    return rhs
-
-
-def _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver,
-                    rtol=DEFAULT_RTOL, info=None, estimated=False, groups_of=None):
-    """Compiled path of :func:`shape_operator` (reference: :func:`_shape_operator_reference`).
-
-    A mesh with several connected components is solved in independent groups
-    (:func:`igl_hhj.components.solve_groups`): no component depends on another.
-    ``estimated``: ``boundary_normals`` come from :func:`estimate_boundary_normals`
-    (see :func:`_boundary_partition`).  ``groups_of``: a mesh with the same faces
-    whose components define the groups instead (the caller's mesh for its cut along
-    the creases, :mod:`igl_hhj.features`: the sides of one part are one solve)."""
-    data = (boundary_normals, boundary_shape_operator, simply_supported)
-    groups = None
-    if all(d is None or np.shape(d)[:1] == (mesh.n_vertices,) for d in data):
-        groups = _components.solve_groups(mesh if groups_of is None else groups_of, solver)
-    if groups is None:
-        return _shape_operator_one(mesh, *data, solver, rtol, info, estimated)
-    if len(groups) == 1:              # every component small: one direct solve of the mesh
-        return _shape_operator_one(mesh, *data, groups[0][1], rtol, info, estimated)
-    S = np.empty((mesh.n_faces, 3, 3))
-    for faces, group_solver in groups:
-        sub, verts = _components.submesh(mesh, faces)
-        sub_data = [None if d is None else np.asarray(d)[verts] for d in data]
-        sub_info = {} if info is not None else None
-        S[faces] = _shape_operator_one(sub, *sub_data, group_solver, rtol, sub_info, estimated)
-        if info is not None:
-            info["iterations"] = max(info.get("iterations", 0), sub_info.get("iterations", 0))
-            info.setdefault("solver", sub_info.get("solver"))
-    return S
-
-
-def _shape_operator_one(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver,
-                        rtol=DEFAULT_RTOL, info=None, estimated=False):
-    """:func:`_shape_operator` on one solve group (the whole mesh, or a group of components)."""
-    clamped, ss_edges = _boundary_partition(mesh, boundary_normals, boundary_shape_operator,
-                                            simply_supported, estimated)
-    N = _normalised_boundary_normals(mesh, boundary_normals, clamped, estimated) if clamped.any() else None
-    fixed = ss_edges if ss_edges.any() else None
-    if fixed is not None:
-        rho = _simply_supported_values(mesh, boundary_shape_operator, ss_edges)
-    system = HHJSystem(mesh, fixed=fixed)
-    rhs = kernels.jump_apply(mesh, mesh.V)                    # B X, (#E, 3)
-    np.negative(rhs, out=rhs)                                 # -B X
-    _boundary_rhs(mesh, rhs, clamped, N)
-    if fixed is not None:                                     # eq. 5.18/5.19: move ρ to the load
-        rhs -= system.fixed_coupling(rho)
-        rhs[fixed] = 0.0
-    # coupled: one CG recurrence on the 3 coordinates, so a rotation of V rotates s exactly
-    s, solve_info = system.solve(rhs, solver, rtol, overwrite_rhs=True, coupled=True)   # (#E, 3): σ^k DOFs
-    del rhs
-    if fixed is not None:
-        s[fixed] = rho[fixed]
-    if info is not None:
-        info.update(solve_info)
-    return kernels.shape_operator_faces(mesh, s)              # S_h|_T = -Σ_k ν_T^k σ^k|_T
-
-
-def _shape_operator_reference(mesh, boundary_normals=None, boundary_shape_operator=None,
-                              simply_supported=None, solver="direct", estimated=False):
-    """The readable numpy reference of :func:`_shape_operator` (:mod:`igl_hhj.hhj`)."""
-    clamped, ss_edges = _boundary_partition(mesh, boundary_normals, boundary_shape_operator,
-                                            simply_supported, estimated)
-    proj = HHJProjection(mesh, fixed_edges=ss_edges, solver=solver)
-    X = mesh.V
-    load = proj.plain_boundary_load(X)
-    if clamped.any():
-        N = _normalised_boundary_normals(mesh, boundary_normals, clamped)
-        P = np.eye(3)[None] - N[:, :, None] * N[:, None, :]
-        P[~np.isfinite(P)] = 0.0
-        load[clamped] = clamped_load(mesh, clamped, P)[clamped]
-    fixed_values = _simply_supported_values(mesh, boundary_shape_operator, ss_edges) \
-        if ss_edges.any() else None
-    s = proj.solve(X, load=load, fixed_values=fixed_values)
-    c = -np.einsum("fjk,fk->fj", s[mesh.face_edges], mesh.face_normals)
-    return np.einsum("fj,fjab->fab", c, proj.phi)
-
-
-def _no_named_creases_on_repair(crease_edges, exc):
-    """Named creases refer to the caller's vertices, which a repair renumbers: refused."""
-    if crease_edges is not None:
-        raise ValueError(f"crease_edges cannot be used on a mesh that needs repair ({exc}); repair "
-                         f"it first (igl_hhj.repair.repair_mesh) and name the creases on the "
-                         f"repaired mesh") from exc
-
-
-def _check_rtol(rtol):
-    if isinstance(rtol, (bool, np.bool_)) or not isinstance(rtol, (int, float, np.floating, np.integer)):
-        raise TypeError(f"rtol must be a float, got {type(rtol).__name__}")
-    rtol = float(rtol)
-    if not 0.0 < rtol < 1.0:
-        raise ValueError(f"rtol must be in (0, 1), got {rtol}")
-    return rtol
-
-
-# --------------------------------------------------------------------------- public API
 @kernels.with_large_call_heap
 def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary: str = "estimate",
                    boundary_normals: ArrayLike | None = None,
@@ -394,42 +150,9 @@ def shape_operator(V: Any, F: ArrayLike | None = None, *, boundary: str = "estim
     >>> round(float(np.median(np.trace(S, axis1=1, axis2=2))), 2)   # κ1 + κ2 = 2/R
     2.0
     """
-    try:
-        mesh = as_mesh(V, F)
-    except MeshDefectError as exc:       # repairable: only on request (issue 24)
-        if not repair:
-            raise
-        from .repair import repaired_shape_operator
-        kw = dict(boundary=boundary, boundary_normals=boundary_normals,
-                  boundary_shape_operator=boundary_shape_operator, simply_supported=simply_supported,
-                  solver=solver, rtol=rtol, feature_angle=feature_angle)
-        _no_named_creases_on_repair(crease_edges, exc)
-        return repaired_shape_operator(shape_operator, exc, V, F, kw)
-    groups_of = None
-    if feature_angle is not None or crease_edges is not None:
-        from .features import _prepare
-        groups_of, _, _, mesh = _prepare(mesh, None, feature_angle, crease_edges, boundary,
-                                         (boundary_normals, boundary_shape_operator, simply_supported))
-    return _checked_shape_operator(mesh, boundary, boundary_normals, boundary_shape_operator,
-                                   simply_supported, solver, rtol, groups_of)
-
-
-def _checked_shape_operator(mesh, boundary, boundary_normals, boundary_shape_operator, simply_supported,
-                            solver, rtol, groups_of=None):
-    """:func:`shape_operator` on a validated mesh (also the cut mesh of
-    :func:`igl_hhj.features.feature_shape_operator`, ``groups_of`` the uncut mesh): the
-    boundary treatment, :func:`_shape_operator`, and no silent NaN."""
-    boundary_normals, treatment = _resolve_boundary(mesh, boundary, boundary_normals,
-                                                    boundary_shape_operator)
-    S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver,
-                        _check_rtol(rtol), estimated=treatment == "estimate", groups_of=groups_of)
-    bad = ~np.isfinite(S).all(axis=(1, 2))
-    if bad.any():                     # never silent NaN (issue 12)
-        from .errors import SolverError
-        raise SolverError(f"the HHJ solve returned NaN/inf on {int(bad.sum())} faces (first "
-                          f"{int(np.flatnonzero(bad)[0])}); try solver='direct'",
-                          faces=np.flatnonzero(bad))
-    return S
+    return pipeline.shape_operator(V, F, pipeline.Options(
+        boundary, boundary_normals, boundary_shape_operator, simply_supported, solver, rtol, feature_angle,
+        crease_edges), repair_defects=repair)
 
 
 @kernels.with_large_call_heap
@@ -466,12 +189,13 @@ def surface_hessian(V: Any, F: ArrayLike | None, w: ArrayLike, *, boundary_gradi
     """
     try:
         mesh = as_mesh(V, F)
-    except MeshDefectError as exc:       # repairable: only on request (issue 24)
+    except MeshDefectError as exc:       # repairable: only on request
         if not repair:
             raise
-        from .repair import repaired_surface_hessian
-        return repaired_surface_hessian(surface_hessian, exc, V, F, w, dict(
-            boundary_gradient=boundary_gradient, solver=solver, rtol=rtol))
+        R, H = pipeline.on_repaired_mesh(exc, V, F, dict(w=w, boundary_gradient=boundary_gradient),
+                                         lambda V2, F2, data: surface_hessian(V2, F2, solver=solver, rtol=rtol, **data),
+                                         "the surface Hessian", stacklevel=4)
+        return face_values_to_caller(R, np.zeros((0,) + np.shape(w)[1:] + (3, 3)) if H is None else H)[0]
     w_arr = _as_array(w, "w")             # np.asarray dropped a mask silently
     single = w_arr.ndim == 1
     if single:
@@ -484,15 +208,15 @@ def surface_hessian(V: Any, F: ArrayLike | None, w: ArrayLike, *, boundary_gradi
     if not np.isfinite(W[ref]).all():
         raise ValueError(f"w has NaN or inf at vertex {int(np.flatnonzero(~np.isfinite(W).all(1) & ref)[0])}")
     W = np.where(np.isfinite(W), W, 0.0)
-    _check_magnitude(W, np.arange(len(W)), "w")
-    rtol = _check_rtol(rtol)
+    check_magnitude(W, np.arange(len(W)), "w")
+    rtol = pipeline.check_rtol(rtol)
     rhs = -kernels.jump_apply(mesh, W)                        # -B w, (#E, k)
     bnd = mesh.boundary_edges
     if boundary_gradient is not None and mesh.has_boundary:
         G = _as_array(boundary_gradient, "boundary_gradient")
         G = per_vertex_array(mesh, G, "boundary_gradient", (3,))[:, None, :] if single \
             else per_vertex_array(mesh, G, "boundary_gradient", (W.shape[1], 3))
-        _data_rows(mesh, G, bnd, "boundary_gradient")
+        data_rows(mesh, G, bnd, "boundary_gradient")
         G = np.where(np.isfinite(G), G, 0.0)
         rhs[bnd] += clamped_load(mesh, bnd, G)[bnd]
     else:
@@ -532,25 +256,6 @@ def principal_from_shape_operator(S: NDArray[np.floating], normals: NDArray[np.f
     return kernels.principal_2x2(S, N)
 
 
-def _principal_from_shape_operator_reference(S, normals):
-    """The readable numpy reference of :func:`principal_from_shape_operator` (``eigh``)."""
-    N = normals
-    # Tangent frame: e1 ⟂ N from the coordinate axis least aligned with N.
-    ax = np.eye(3)[np.argmin(np.abs(N), axis=1)]
-    e1 = np.cross(N, ax)
-    e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
-    e2 = np.cross(N, e1)
-    E = np.stack([e1, e2], axis=2)                      # (n, 3, 2)
-    S2 = np.einsum("nai,nab,nbj->nij", E, S, E)
-    S2 = 0.5 * (S2 + np.swapaxes(S2, 1, 2))
-    w, U = np.linalg.eigh(S2)                           # ascending
-    PV1, PV2 = w[:, 1], w[:, 0]
-    PD1 = np.einsum("nai,ni->na", E, U[:, :, 1])
-    PD1 /= np.linalg.norm(PD1, axis=1, keepdims=True)
-    PD2 = np.cross(N, PD1)
-    return PD1, PD2, PV1, PV2
-
-
 @kernels.with_large_call_heap
 def face_principal_curvature(V: Any, F: ArrayLike | None = None, *, smoothing: float = 0,
                              **boundary: Any) -> tuple[NDArray[np.float64], ...]:
@@ -562,10 +267,11 @@ def face_principal_curvature(V: Any, F: ArrayLike | None = None, *, smoothing: f
     smoothing : float, default 0
         Smoothing scale in the units of :func:`principal_curvature`'s ``radius``
         (rings ≈ mean edge lengths).  0: Walker's S_h itself.  > 0: S_h is
-        recovered at the vertices, smoothed at length
-        ``ℓ = SMOOTHING_PER_RADIUS · smoothing · h̄``
-        (:func:`igl_hhj.recovery.smooth_vertex_tensors`), and each face gets
-        the mean of its three vertex tensors projected onto its plane.
+        recovered at the vertices and smoothed as by :func:`principal_curvature`
+        with ``radius = smoothing`` (the per-face adaptive length
+        ``ℓ_T = SMOOTHING_PER_RADIUS · r_T · h_T``, see there;
+        :func:`vertex_shape_operator`), and each face gets the mean of its three
+        vertex tensors projected onto its plane.
     **boundary : ``boundary``, boundary data, ``solver`` of :func:`shape_operator`.
 
     Returns
@@ -621,18 +327,6 @@ def face_gaussian_curvature(V: Any, F: ArrayLike | None = None, **boundary: Any)
     return np.linalg.det(S + nu[:, :, None] * nu[:, None, :])
 
 
-def check_principal_curvature_args(radius, useKring):
-    """Validate the ``radius`` / ``useKring`` arguments of ``igl.principal_curvature``'s signature."""
-    if isinstance(radius, (bool, np.bool_)) or not isinstance(radius, (int, np.integer)):
-        raise TypeError(f"radius must be an int (as in igl.principal_curvature), got {type(radius).__name__}")
-    if not radius > 0:
-        raise ValueError(f"radius must be positive, got {radius}")
-    if radius > 10**6:      # a smoothing scale / k-ring beyond any mesh; 10**300 overflowed
-        raise ValueError(f"radius must be <= 10**6 (a smoothing scale in rings), got {radius:.3g}")
-    if not isinstance(useKring, (bool, np.bool_)):
-        raise TypeError(f"useKring must be a bool (as in igl.principal_curvature), got {type(useKring).__name__}")
-
-
 def vertex_principal_curvature(mesh, Sv, N):
     """Principal directions/curvatures of per-vertex tensors, NaN at unreferenced vertices.
 
@@ -665,14 +359,15 @@ def vertex_shape_operator(mesh, S, *, smoothing=0, recovery="intrinsic"):
     linear least-squares patch fit, and (``smoothing > 0``) smoothed by the twiced
     implicit diffusion of its trace (scalar cotangent Laplacian) and its deviator
     (spin-2 connection Laplacian) at the per-face length
-    ``ℓ_T = SMOOTHING_PER_RADIUS · smoothing · h_T``.
+    ``ℓ_T = SMOOTHING_PER_RADIUS · r_T · h_T``, ``r_T`` the adaptive radius at scale
+    ``smoothing`` (see :func:`principal_curvature`'s ``radius``).
 
-    The ambient variants average the 3×3 tensors of the incident faces and project
-    the result onto the vertex plane (biased where the normal turns fast, e.g. thin
-    tubes; kept for comparison): "patch" (linear fit), "lumped" (weighted average)
-    and "consistent" (consistent-mass L2 projection), each followed for
-    ``smoothing > 0`` by :func:`igl_hhj.recovery.smooth_vertex_tensors` at the
-    global length ``ℓ = SMOOTHING_PER_RADIUS · smoothing · h̄``.
+    The ambient variants, kept for comparison (numpy, :mod:`igl_hhj.recovery`), average
+    the 3×3 tensors of the incident faces and project the result onto the vertex plane
+    (biased where the normal turns fast, e.g. thin tubes): "patch" (linear fit), "lumped"
+    (weighted average) and "consistent" (consistent-mass L2 projection), each followed for
+    ``smoothing > 0`` by :func:`igl_hhj.recovery.smooth_vertex_tensors` at the global length
+    ``ℓ = SMOOTHING_PER_RADIUS · smoothing · h̄``.
 
     Returns
     -------
@@ -685,34 +380,11 @@ def vertex_shape_operator(mesh, S, *, smoothing=0, recovery="intrinsic"):
         Sv = _intrinsic.to_tensors(X, N)
         Sv[~mesh.referenced_vertices] = np.nan
         return Sv, N
-    if recovery == "patch":       # compiled (reference: _vertex_shape_operator_numpy)
-        length = _recovery.smoothing_length(mesh, smoothing) if smoothing > 0 else 0.0
-        return _recovery.recover_and_smooth(mesh, S, length)
-    return _vertex_shape_operator_numpy(mesh, S, smoothing=smoothing, recovery=recovery)
-
-
-def _vertex_shape_operator_numpy(mesh, S, *, smoothing=0, recovery="patch"):
-    """The readable numpy reference of :func:`vertex_shape_operator` (any ``recovery``)."""
     w = _recovery.recovery_weights(mesh)          # one computation for recovery and smoothing
     Sv, N = _recovery.recover_vertex_tensors(mesh, S, method=recovery, weights=w)
     if smoothing > 0:
         Sv = _recovery.smooth_vertex_tensors(mesh, Sv, N, _recovery.smoothing_length(mesh, smoothing),
                                              weights=w)
-    return Sv, N
-
-
-def _vertex_shape_operator_reference(mesh, S):
-    """Numpy reference of the compiled lumped recovery :func:`igl_hhj.kernels.lumped_vertex_recovery`
-    (the area-weighted 1-ring average; ``recovery="lumped"`` of :func:`vertex_shape_operator`
-    uses sliver-aware weights instead)."""
-    N = mesh.vertex_normals
-    A = np.broadcast_to(mesh.face_areas[:, None], (mesh.n_faces, 3))
-    acc = mesh.sum_corners_to_vertices(A[:, :, None, None] * S[:, None])
-    wsum = mesh.sum_corners_to_vertices(A)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        Sv = acc / wsum[:, None, None]
-    P = np.eye(3)[None] - N[:, :, None] * N[:, None, :]
-    Sv = P @ Sv @ P
     return Sv, N
 
 
@@ -730,8 +402,8 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
     Same call forms, same return tuple, shapes, dtypes, ordering and sign, but
     the values come from Walker's convergent HHJ shape operator
     (:func:`shape_operator`), recovered at the vertices and smoothed at the
-    length scale ``radius`` (:func:`vertex_shape_operator`), then a 2×2
-    eigen-problem.
+    scale ``radius`` (:func:`vertex_shape_operator`), then a 2×2 eigen-problem
+    (the stages: :mod:`igl_hhj.pipeline`).
 
     Parameters
     ----------
@@ -740,13 +412,20 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
     F : (#F, 3) array_like
         Triangle indices.
     radius : int, default 5
-        Smoothing scale, as libigl's neighbourhood size: rings (``useKring``)
-        or mean edge lengths (``useKring=False``), which for HHJ are the same
-        length ``ℓ = SMOOTHING_PER_RADIUS · radius · h̄`` (h̄ the mean edge
-        length, ``SMOOTHING_PER_RADIUS`` = 0.2) of the implicit diffusion of
-        the recovered tensor field (:func:`igl_hhj.recovery.smooth_vertex_tensors`).
-        Larger: less noise, more bias.  ℓ shrinks with h, so the values
-        converge at O(h) for every fixed radius.
+        Smoothing scale, as libigl's neighbourhood size in rings (``useKring``) or
+        mean edge lengths (``useKring=False``): for this estimator the two are the
+        same scale.  The recovered tensor field is smoothed by a twiced implicit
+        diffusion whose length is set per face (:mod:`igl_hhj.intrinsic`):
+        ``ℓ_T = SMOOTHING_PER_RADIUS · r_T · h_T`` with h_T the face's mean edge
+        length, ``SMOOTHING_PER_RADIUS`` = 0.2, and the adaptive radius
+        ``r_T = radius · mean_{v∈T} a_v``, ``a_v = clip(0.3 ρ̄_v^{1/4} / c̄_v, 0.2, 5)``:
+        ρ̄ the measured roughness of S_h around the vertex, c̄ the curvature of a
+        pilot smoothing step times the local edge length (constants:
+        :mod:`igl_hhj.constants`).  At the default radius a smooth mesh gets
+        r_T ≈ 1–9, thin features (c̄ large) ``0.2 · radius``, noisy scans up to
+        ``5 · radius``; within 2 rings of an open boundary ℓ_T is twice as long.
+        Larger: less noise, more bias.  ℓ_T follows the local edge length (the
+        tests measure the O(h) rate at the default radius).
     useKring : bool, default True
         Accepted for compatibility (see ``radius``).
     boundary : {"estimate", "plain"}, default "estimate"
@@ -756,7 +435,7 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
     boundary_normals, boundary_shape_operator, simply_supported, solver, rtol
         Keyword-only extras, see :func:`shape_operator`.
     feature_angle : float, optional (keyword-only; default None: off, libigl's contract)
-        Sharp features (issue 27): edges whose dihedral angle exceeds ``feature_angle``
+        Sharp features: edges whose dihedral angle exceeds ``feature_angle``
         degrees are creases; the surface is cut along them and each side is clamped
         with its own one-sided normals, so that the smooth parts converge up to the
         crease and no value is averaged across it
@@ -809,83 +488,9 @@ def principal_curvature(V: Any, F: ArrayLike | None = None, radius: int = 5, use
     >>> round(float(np.median(PV1)), 2)         # +1/R on a sphere with outward normals
     1.0
     """
-    check_principal_curvature_args(radius, useKring)
-    if all(x is None for x in (feature_angle, crease_edges, boundary_normals, boundary_shape_operator,
-                               simply_supported)) \
-            and isinstance(solver, str) and solver in ("auto", "direct") \
-            and isinstance(boundary, str) and boundary in BOUNDARY_TREATMENTS:
-        # a small clean mesh: the same values in one compiled call (igl_hhj.small_mesh)
-        out = _small_mesh.try_dropin(V, F, radius, _check_rtol(rtol), boundary)
-        if out is not None:
-            return out
-    try:
-        mesh = as_mesh(V, F, copy=False)     # private to this call: views, not copies, of V, F
-    except MeshDefectError as exc:       # repairable defect: repair, compute, map back (issue 24)
-        from .repair import repaired_principal_curvature
-        kw = dict(boundary=boundary, boundary_normals=boundary_normals,
-                  boundary_shape_operator=boundary_shape_operator, simply_supported=simply_supported,
-                  solver=solver, rtol=rtol, feature_angle=feature_angle)
-        _no_named_creases_on_repair(crease_edges, exc)
-        return repaired_principal_curvature(principal_curvature, exc, V, F, radius, useKring, kw)
-    if feature_angle is not None or crease_edges is not None:
-        from .features import _feature_dropin
-        return _feature_dropin(mesh, None, radius, feature_angle=feature_angle, crease_edges=crease_edges,
-                               boundary=boundary, solver=solver, rtol=rtol,
-                               data=(boundary_normals, boundary_shape_operator, simply_supported))
-    return dropin_on_mesh(mesh, radius, boundary, boundary_normals, boundary_shape_operator,
-                          simply_supported, solver, rtol, release=True)
-
-
-def dropin_on_mesh(mesh, radius, boundary, boundary_normals, boundary_shape_operator, simply_supported,
-                   solver, rtol, groups_of=None, release=False, by_parts=False):
-    """:func:`principal_curvature` on a validated :class:`~igl_hhj.mesh.TriangleMesh` (also
-    the cut mesh of :mod:`igl_hhj.features`, with ``groups_of`` the uncut mesh, see
-    :func:`_shape_operator`): the boundary treatment, S_h (:func:`_shape_operator`), then
-    :func:`dropin_vertex_values`.  ``release``: the mesh's face cross products (24 B/face)
-    are dropped from its cache before the solve, the call's memory peak (for a mesh that
-    needs them no more afterwards).  ``by_parts``: the smoothing runs one compiled call per
-    connected component (:func:`igl_hhj.intrinsic.vertex_stage`'s ``by_parts``: the sides
-    of the cut, grouped by the caller's parts)."""
-    boundary_normals, treatment = _resolve_boundary(mesh, boundary, boundary_normals,
-                                                    boundary_shape_operator)
-    rtol = _check_rtol(rtol)
-    if release:
-        # the vertex stage's normals now, then the face cross products they come from are
-        # released (the default path does not read them again; if asked for, the numpy
-        # property recomputes them, equal to round-off)
-        mesh.vertex_normals
-        mesh.__dict__.pop("_cross", None)
-    S = _shape_operator(mesh, boundary_normals, boundary_shape_operator, simply_supported, solver,
-                        rtol, estimated=treatment == "estimate", groups_of=groups_of)
-    holder = [S]     # the only reference: the vertex stage frees S before smoothing
-    del S
-    return dropin_vertex_values(mesh, holder, radius, rtol, by_parts=by_parts)
-
-
-def dropin_vertex_values(mesh, S, radius, rtol=DEFAULT_RTOL, by_parts=False):
-    """The vertex stage of :func:`principal_curvature` on given face tensors ``S`` (#F, 3, 3).
-
-    :func:`igl_hhj.intrinsic.vertex_stage` (intrinsic recovery, adaptive twiced
-    smoothing at scale ``radius``), then ``κ1,2 = H ± |z|`` and the directions
-    (:func:`igl_hhj.kernels.principal_hz`), NaN rows at unreferenced vertices and at
-    vertices without a tangent plane (:func:`igl_hhj.mesh.mark_bad_vertices`).  ``S`` is
-    may be given as a one-element list, emptied after the recovery, so that the face
-    tensors are freed before the smoothing (the call's memory peak).
-
-    Returns
-    -------
-    PD1, PD2 : (#V, 3), PV1, PV2 : (#V,), bad_vertices : list of int (as :func:`principal_curvature`).
-    """
-    X, N = _intrinsic.vertex_stage(mesh, S, radius, rtol=rtol, by_parts=by_parts)
-    PD1, PD2, PV1, PV2 = kernels.principal_hz(X, N)
-    del X
-    ref = mesh.referenced_vertices
-    if not ref.all():
-        for A in (PD1, PD2, PV1, PV2):
-            A[~ref] = np.nan
-    PD1, PD2, PV1, PV2, bad = mark_bad_vertices(mesh, PD1, PD2, PV1, PV2, copy=False)
-    return (np.ascontiguousarray(PD1), np.ascontiguousarray(PD2),
-            np.ascontiguousarray(PV1), np.ascontiguousarray(PV2), bad)
+    return pipeline.principal_curvature(V, F, radius, useKring, pipeline.Options(
+        boundary, boundary_normals, boundary_shape_operator, simply_supported, solver, rtol, feature_angle,
+        crease_edges))
 
 
 # --------------------------------------------------------------------------- one call, any mesh

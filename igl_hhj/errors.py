@@ -8,6 +8,9 @@ Every failure igl_hhj reports on purpose is one of Python's ``TypeError`` /
   when they are known (e.g. near-degenerate triangles), else it is empty.
 * :class:`SolverDidNotConverge` (a :class:`SolverError`): an iterative solve
   stopped at its iteration cap above its tolerance.
+* :class:`MeshFileError` (a ``ValueError``): a mesh or output file that cannot be
+  used (:mod:`igl_hhj.mesh_io`, :mod:`igl_hhj.polygon_io`), one line naming the file
+  and the problem.
 
 A missing optional package is an ``ImportError``; :func:`install_hint` says
 how to install it (the command line and the demos print it).
@@ -16,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["SolverError", "SolverDidNotConverge", "OPTIONAL_PACKAGES", "install_hint", "missing_optional"]
+__all__ = ["SolverError", "SolverDidNotConverge", "MeshFileError", "OPTIONAL_PACKAGES", "install_hint", "missing_optional"]
 
 OPTIONAL_PACKAGES = {
     "matplotlib": ("matplotlib", "demos"),
@@ -76,3 +79,7 @@ class SolverError(RuntimeError):
 
 class SolverDidNotConverge(SolverError):
     """An iterative solve stopped at its iteration cap above its tolerance."""
+
+
+class MeshFileError(ValueError):
+    """A mesh or output file the command line cannot use (message: one line)."""

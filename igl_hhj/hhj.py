@@ -27,8 +27,11 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from .boundary import clamped_load  # the boundary load, named here as before
+from .constants import SPD_AUTO_DIRECT_MAX
 from .errors import SolverDidNotConverge
 from .mesh import TriangleMesh
+from .solvers import solve_spd  # the generic SPD solve, named here as before
 
 __all__ = [
     "local_basis", "mass_matrix", "jump_matrix", "face_tensors", "nn_moments",
@@ -37,11 +40,6 @@ __all__ = [
 ]
 
 
-# solver="auto" factorises directly up to this many unknowns, above it uses PCG.
-AUTO_DIRECT_MAX = 50000
-# ... and gives PCG this many iterations before falling back to the direct solver
-# (well-shaped meshes need 50–250; meshes full of slivers can need thousands).
-AUTO_CG_MAXITER = 600
 
 
 def _sym_outer(u, v):
@@ -134,39 +132,6 @@ def nn_moments(mesh: TriangleMesh, sigma):
     return np.einsum("fia,fab,fib->fi", n, sigma, n)
 
 
-def clamped_load(mesh: TriangleMesh, edge_mask, gradient):
-    """Clamped boundary load ``g_e = ∫_e n·ξ ds`` for P1-interpolated data ξ.
-
-    Parameters
-    ----------
-    edge_mask : (#E,) bool, edges receiving data (boundary edges).
-    gradient : (#V, k, 3) surface gradients ξ of k functions at the vertices
-        (rows of vertices not on a masked edge are ignored).
-
-    Returns
-    -------
-    g : (#E, k) float64, zero off the mask.  Exact for linear ξ along the edge.
-    """
-    k = gradient.shape[1]
-    g = np.zeros((mesh.n_edges, k))
-    e = np.flatnonzero(edge_mask)
-    if e.size == 0:
-        return g
-    f = mesh.edge_faces[e, 0]
-    f = np.where(f >= 0, f, mesh.edge_faces[e, 1])
-    i = np.where(mesh.edge_faces[e, 0] >= 0, mesh.edge_local_index[e, 0], mesh.edge_local_index[e, 1])
-    n = mesh.conormals_at(f, i)                   # (m, 3)
-    va, vb = mesh.edges[e, 0], mesh.edges[e, 1]
-    xi = 0.5 * (gradient[va] + gradient[vb])      # (m, k, 3) mean over the edge
-    # n·ξ summed (n0 ξ0 + n1 ξ1) + n2 ξ2 in this order on every machine (einsum's order
-    # depends on the SIMD width), as the compiled small-mesh path (igl_hhj.small_mesh)
-    s = n[:, None, 0] * xi[:, :, 0]
-    s += n[:, None, 1] * xi[:, :, 1]
-    s += n[:, None, 2] * xi[:, :, 2]
-    g[e] = mesh.unique_edge_lengths[e, None] * s
-    return g
-
-
 def face_schwarz_preconditioner(mesh: TriangleMesh, A, phi=None, free=None):
     """Additive Schwarz preconditioner over faces for the HHJ matrix A.
 
@@ -251,141 +216,6 @@ def _robust_block_inverse(blk):
     return ci * d[:, :, None] * d[:, None, :]
 
 
-def solve_spd(A, R, *, method="auto", rtol=1e-10, maxiter=None, preconditioner=None):
-    """Solve ``A X = R`` for an SPD sparse A and all columns of R at once.
-
-    Parameters
-    ----------
-    A : (n, n) scipy.sparse SPD matrix
-    R : (n,) or (n, k) right-hand sides
-    method : {"auto", "cg", "direct"}
-        "cg": the compiled fused block PCG (:func:`igl_hhj.kernels.block_pcg`)
-        over the k columns, preconditioned by ``preconditioner`` (a sparse SPD
-        approximation of A⁻¹, e.g. :func:`face_schwarz_preconditioner`) or,
-        without one, Jacobi.
-        "direct": one sparse factorisation (:func:`igl_hhj.solvers.cholesky_solve`:
-        QDLDL up to 200k unknowns, CHOLMOD via cholespy above, pivoted SuperLU when the
-        residual check fails).
-        "auto": direct up to ``AUTO_DIRECT_MAX`` (50 000) unknowns; above,
-        PCG, switching to the direct solver as soon as the measured
-        convergence rate predicts more than ``maxiter`` (default
-        ``AUTO_CG_MAXITER`` = 600) further iterations (checked every 20 iterations).
-    rtol : float
-        CG stops when ``‖r_j‖ ≤ rtol ‖R_j‖`` for every column j.  The default
-        1e-10 leaves a solver error far below every discretisation error in
-        the convergence tables (tests compare CG with the direct solve).
-    maxiter : int, optional
-        CG iteration cap (default 2000 for "cg", 600 for "auto").
-    preconditioner : (n, n) scipy.sparse matrix, optional
-        Applied as ``z = M r``.  Anything else with ``@`` (e.g. a
-        ``LinearOperator``) runs the numpy reference PCG :func:`_block_pcg`.
-
-    Raises
-    ------
-    SolverDidNotConverge
-        method="cg" and CG did not reach ``rtol`` within ``maxiter`` iterations.
-    """
-    from . import solvers
-    R = np.asarray(R, dtype=np.float64)
-    vec = R.ndim == 1
-    if vec:
-        R = R[:, None]
-    n = A.shape[0]
-    if method not in ("auto", "cg", "direct"):
-        raise ValueError(f"unknown solver method {method!r}; use 'auto', 'cg' or 'direct'")
-    if method == "auto" and n <= AUTO_DIRECT_MAX:
-        method = "direct"
-    X = None
-    if maxiter is None:
-        maxiter = AUTO_CG_MAXITER if method == "auto" else 2000
-    if method in ("cg", "auto") and n > 0:
-        if preconditioner is not None and not sp.issparse(preconditioner):
-            try:
-                X = _block_pcg(sp.csr_matrix(A), R, rtol, maxiter, preconditioner)
-            except SolverDidNotConverge:
-                if method == "cg":
-                    raise
-        else:
-            Ac = sp.csr_matrix(A)
-            Mc = None
-            dinv = None
-            if preconditioner is None:
-                dinv = 1.0 / Ac.diagonal()
-            else:
-                Mc = sp.csr_matrix(preconditioner)
-                Mc = (Mc.indptr, Mc.indices, Mc.data)
-            Xc, it, status, relres = solvers.pcg(
-                Ac.indptr, Ac.indices, Ac.data, R, rtol=rtol, maxiter=maxiter, M=Mc, dinv=dinv,
-                probe_iter=20 if method == "auto" else 0, max_predicted=maxiter)
-            if status == 0:
-                X = Xc
-            elif method == "cg":
-                raise SolverDidNotConverge(
-                    f"preconditioned CG did not converge in {it} iterations "
-                    f"(relative residual {max(relres):.2e} > {rtol:.1e}); the mesh may contain "
-                    f"near-degenerate triangles. Use solver='direct' or solver='auto'.")
-    if X is None:
-        X = np.zeros_like(R) if n == 0 else solvers.cholesky_solve(A, R)
-    return X[:, 0] if vec else X
-
-
-def _block_pcg(A, R, rtol, maxiter, M=None):
-    """The numpy reference of the compiled block PCG: CG on the columns of R at once (independent recurrences,
-    shared sparse products).  Buffers are reused: at 10⁵–10⁶ unknowns each
-    iteration is memory-bound."""
-    n, k = R.shape
-    if maxiter is None:
-        maxiter = 2000
-    if M is None:
-        dinv = (1.0 / A.diagonal())[:, None]
-        def apply(r):  # noqa: E306
-            return dinv * r
-    else:
-        def apply(r):  # noqa: E306
-            return M @ r
-    tmp = np.empty((n, k))
-    ones = np.ones(n)
-
-    def coldot(a, b):  # column-wise dot products; `ones @` is a BLAS gemv, 50x faster than .sum(0)
-        np.multiply(a, b, out=tmp)
-        return ones @ tmp
-
-    X = np.zeros((n, k))
-    r = R.copy()
-    bb = coldot(R, R)
-    tol2 = (rtol ** 2) * bb
-    rr = bb
-    active = rr > tol2
-    if not active.any():
-        return X
-    z = apply(r)
-    p = z.copy()
-    rz = coldot(r, z)
-    for _ in range(maxiter):
-        q = A @ p
-        pq = coldot(p, q)
-        alpha = np.where(active, rz / np.where(active, pq, 1.0), 0.0)
-        np.multiply(p, alpha, out=tmp)
-        X += tmp
-        np.multiply(q, alpha, out=tmp)
-        r -= tmp
-        rr = coldot(r, r)
-        active = rr > tol2
-        if not active.any():
-            return X
-        z = apply(r)
-        rz_new = coldot(r, z)
-        beta = np.where(active, rz_new / np.where(active, rz, 1.0), 0.0)
-        rz = rz_new
-        p *= beta
-        p += z
-    worst = float(np.max(np.sqrt(rr / np.where(bb > 0, bb, 1.0))))
-    raise SolverDidNotConverge(
-        f"preconditioned CG did not converge in {maxiter} iterations "
-        f"(relative residual {worst:.2e} > {rtol:.1e}); the mesh may contain "
-        f"near-degenerate triangles. Use solver='direct' or solver='auto'.")
-
-
 class HHJProjection:
     """HHJ projection of surface Hessians of P1 functions on one mesh.
 
@@ -462,7 +292,7 @@ class HHJProjection:
         else:
             rhs_f = rhs
         M = None
-        if self.solver == "cg" or (self.solver == "auto" and self._A_ff.shape[0] > AUTO_DIRECT_MAX):
+        if self.solver == "cg" or (self.solver == "auto" and self._A_ff.shape[0] > SPD_AUTO_DIRECT_MAX):
             M = face_schwarz_preconditioner(self.mesh, self.A, self.phi,
                                             self.free if self.fixed.any() else None)
         s[self.free] = solve_spd(self._A_ff, rhs_f, method=self.solver, preconditioner=M)

@@ -1,54 +1,38 @@
 """Thin Python face of the compiled core ``igl_hhj._hhj_core`` (C++17, nanobind).
 
-This is the only module that imports the extension.  Every function checks and
-coerces its arrays once (C-contiguous float64 / int64, shapes; the topology maps of
-:class:`igl_hhj.mesh.TriangleMesh` as they are stored, int32 indices and int8 local
-indices, so no call copies them) and hands them to one C++ kernel; the kernels have no hidden state and release the GIL.  The
-readable numpy reference of each kernel is named in its docstring; tests
-(``tests/core/test_core.py``) compare the two.
+Every function checks and coerces its arrays once (C-contiguous float64 / int64, shapes;
+the topology maps of :class:`igl_hhj.mesh.TriangleMesh` as they are stored, int32 indices
+and int8 local indices, so no call copies them) and hands them to one C++ kernel; the
+kernels have no hidden state and release the GIL.  The readable numpy reference of each
+kernel is named in its docstring; tests (``tests/core/``, ``tests/mesh/``, ``tests/hhj/``,
+``tests/vertex_stage/``) compare the two.
 
-Threads: a kernel uses all OpenMP threads (``OMP_NUM_THREADS``) when it is the
-only igl_hhj kernel running, and one thread when called while another one runs
-(several Python threads), so concurrent callers never oversubscribe the cores.
-Reductions use a fixed chunking, so results are bit-identical for any thread
-count.
+The extension is loaded, and its thread and heap policy kept, by :mod:`igl_hhj.runtime`:
+every wrapper applies the thread policy (:func:`igl_hhj.runtime.apply_thread_policy`)
+before its call.  The runtime's functions and its documented switches are also reachable
+here under their old names (``kernels.set_num_threads``, ``kernels.run_tasks``,
+``kernels.ADAPT_TO_LOAD = False``, ``kernels.LARGE_CALL_HEAP = False``, ...): reading or
+setting a switch here reads or sets :mod:`igl_hhj.runtime`'s.
 """
 from __future__ import annotations
 
-import functools
-import os
-import threading
-import time
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
-from typing import Any, ParamSpec, TypeVar
+import sys
+import types
 
 import numpy as np
 
-# Idle OpenMP threads sleep instead of spinning (libgomp reads this when the extension
-# loads it).  Measured on the shared 2-core machine (load 8): with the default spinning,
-# two threads made the drop-in 1.8x slower than one; passive waiting made them equal.
-os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
-
-try:
-    from . import _hhj_core
-except ImportError as exc:  # pragma: no cover - exercised only on a broken install
-    raise ImportError(
-        "igl_hhj's compiled core (igl_hhj._hhj_core) is missing or failed to load "
-        f"({exc}). It is built when igl_hhj is installed: reinstall on a machine with a "
-        "C++17 compiler and cmake, e.g. `pip install --force-reinstall --no-cache-dir .` "
-        "from the igl_hhj source tree (scikit-build-core and nanobind come from PyPI)."
-    ) from exc
-_core: Any = _hhj_core      # the extension has no stubs: its functions are typed here, by the wrappers
+from . import runtime
+from .runtime import (apply_thread_policy as _threads, core as _core, large_call_heap,  # noqa: F401
+                      max_threads, run_tasks, set_num_threads, task_workers, with_large_call_heap)
 
 __all__ = [
     "topology", "hhj_system", "jump_apply", "block_pcg", "shape_operator_faces",
-    "face_tensors", "lumped_vertex_recovery", "principal_2x2", "max_threads",
-    "set_num_threads", "ell_indptr", "edge_morton_order", "recovery_weights", "patch_recovery",
-    "tangent_projection6", "smooth_vertex_tensors", "face_metrics", "vertex_area_sums",
+    "face_tensors", "principal_2x2", "max_threads",
+    "set_num_threads", "ell_indptr", "edge_morton_order", "recovery_weights",
+    "face_metrics", "vertex_area_sums",
     "intrinsic_patch_recovery", "vertex_components", "transport_phases",
     "adaptive_radius", "principal_hz", "intrinsic_smoothing", "dihedral_magnitudes", "crease_cut",
-    "run_tasks", "task_workers",
+    "run_tasks", "task_workers", "dropin_small",
     "large_call_heap", "with_large_call_heap", "LARGE_CALL_HEAP",
 ]
 
@@ -72,185 +56,21 @@ def _i8(a):
     return np.ascontiguousarray(a, dtype=np.int8)
 
 
-_USER_THREADS = _core.max_threads()     # OMP_NUM_THREADS or the core count
-# Run single-threaded while the machine is already busy (1-minute load average ≥ the
-# number of cores): extra threads then only queue behind other processes.  Results do
-# not depend on the thread count (fixed-chunk reductions).
-ADAPT_TO_LOAD = True
+def _switch(name):
+    """A property of this module that reads and sets :mod:`igl_hhj.runtime`'s ``name``."""
+    return property(lambda self: getattr(runtime, name), lambda self, value: setattr(runtime, name, value),
+                     doc=f"igl_hhj.runtime.{name}")
 
 
-def max_threads():
-    """Number of OpenMP threads a kernel may use (1 without OpenMP)."""
-    return _core.max_threads()
+class _Kernels(types.ModuleType):
+    """This module's type: its runtime switches are :mod:`igl_hhj.runtime`'s."""
+
+    ADAPT_TO_LOAD = _switch("ADAPT_TO_LOAD")
+    LARGE_CALL_HEAP = _switch("LARGE_CALL_HEAP")
+    TASKS_MIN_WORK = _switch("TASKS_MIN_WORK")
 
 
-def set_num_threads(n):
-    """Set the OpenMP thread count of igl_hhj's kernels (``omp_set_num_threads``)."""
-    global _USER_THREADS
-    _USER_THREADS = max(1, int(n))
-    _core.set_num_threads(_USER_THREADS)
-
-
-_CPU_COUNT = os.cpu_count() or 1
-# the load average changes on a scale of seconds: read at most this often (a drop-in call
-# on a tiny mesh makes ~10 kernel calls; reading it each time cost 8 % of a 12-face call)
-_LOAD_TTL = 0.25
-_load_cache = [-1.0, False]          # [monotonic time of the reading, busy]
-
-
-def _machine_busy():
-    now = time.monotonic()
-    if now - _load_cache[0] > _LOAD_TTL:
-        try:
-            busy = os.getloadavg()[0] >= _CPU_COUNT
-        except OSError:  # pragma: no cover - no load average on this platform
-            busy = False
-        _load_cache[0], _load_cache[1] = now, busy
-    return _load_cache[1]
-
-
-def _threads():
-    """Apply the thread policy for the next kernel call (calling thread only)."""
-    _core.set_num_threads(task_workers())
-
-
-# kernel calls that are independent of each other (the sides of a cut mesh) run on this
-# many Python threads at most; each call then runs single-threaded (ThreadBudget: a kernel
-# started while another one runs gets one thread), so the cores are never oversubscribed
-_TASK_POOL: list[Any] = []
-# a task pool pays only from this much work in all (vertices): below it the calls take
-# less than the threads' hand-over costs (~50 µs a task)
-TASKS_MIN_WORK = 4000
-
-
-def task_workers() -> int:
-    """The thread policy: the threads of the next kernel call (:func:`_threads`) and how
-    many independent kernel calls may run at once (:func:`run_tasks`): ``OMP_NUM_THREADS``
-    or :func:`set_num_threads`, one while the machine is busy."""
-    n = _USER_THREADS
-    if ADAPT_TO_LOAD and n > 1 and _machine_busy():
-        n = 1
-    return n
-
-
-def run_tasks(fn: Callable[[Any], _R], items, sizes) -> list[_R]:
-    """``[fn(x) for x in items]``, concurrently on up to :func:`task_workers` threads.
-
-    ``fn`` must release the GIL for its work (the compiled kernels do) and its calls must
-    not depend on each other's results.  ``sizes`` (one number per item, its work) orders
-    the start: largest first, so the longest call does not start last (LPT scheduling).
-    Each kernel call inside runs single-threaded, and a kernel's bits do not depend on its
-    thread count, so the results are those of the serial loop, bit for bit.  Serial when
-    one worker is allowed, for one item, or below :data:`TASKS_MIN_WORK` in all.  An
-    exception is raised as from the serial loop (the first item's that raised, in order).
-    """
-    items = list(items)
-    workers = min(task_workers(), len(items))
-    if workers <= 1 or float(np.sum(sizes)) < TASKS_MIN_WORK:
-        return [fn(x) for x in items]
-    if not _TASK_POOL:
-        from concurrent.futures import ThreadPoolExecutor   # lazily: most calls never need it
-        _TASK_POOL.append(ThreadPoolExecutor(max_workers=max(1, _CPU_COUNT - 1), thread_name_prefix="igl_hhj"))
-    pool = _TASK_POOL[0]
-    order = np.argsort(-np.asarray(sizes, dtype=np.float64), kind="stable")
-    # `workers` chains of calls: no more kernels at once than the policy allows
-    queue = list(order[::-1])
-    lock = threading.Lock()
-    out: list[Any] = [None] * len(items)
-
-    def chain():
-        while True:
-            with lock:
-                if not queue:
-                    return
-                i = int(queue.pop())
-            try:
-                out[i] = (True, fn(items[i]))
-            except BaseException as exc:  # re-raised below, in item order
-                out[i] = (False, exc)
-
-    futures = [pool.submit(chain) for _ in range(workers - 1)]
-    chain()                                       # the caller runs one chain itself
-    for future in futures:
-        future.result()
-    for ok, value in out:
-        if not ok:
-            raise value
-    return [value for _, value in out]
-
-
-# Heap policy of a large call (glibc; see igl_hhj/_core/heap.cpp).  glibc raises its mmap
-# threshold by itself only up to 32 MiB, so above about 930k faces each (#E, 3) float64
-# work array is a fresh mapping whose pages all fault on first touch (icosphere(8): 400k
-# minor faults per drop-in call).  Inside the scope the call's arrays come from the heap
-# and are reused between stages; on exit glibc's 32 MiB ceiling is restored and the freed
-# heap is returned (malloc_trim), so no memory is kept between calls.  Measured on
-# icosphere(8): 400k -> 181k faults, drop-in 2.58 -> 2.27 s; no effect below 32 MiB.
-# False: never touch the allocator.  A policy set through MALLOC_MMAP_THRESHOLD_,
-# MALLOC_TRIM_THRESHOLD_ or GLIBC_TUNABLES=glibc.malloc.* is always left alone.
-LARGE_CALL_HEAP = True
-_GLIBC_MMAP_CEILING = 32 << 20
-# the scope's threshold, in units of the call's (#E, 3) float64 array: its edge and vertex
-# work arrays come from the heap, the few larger ones ((#E, 5) matrix rows) stay mappings.
-# Measured on icosphere(8) (threshold 1.5x: 71 MB): 2.13 s, peak 0.57 KB/face, as without
-# the scope; 128 MB and above: 2.03 s but 0.60 KB/face (freed large blocks linger in the
-# heap); 32 MB: 2.45 s
-_HEAP_SCOPE_FACTOR = 1.5
-
-
-def _user_malloc_policy():
-    env = os.environ
-    return ("MALLOC_MMAP_THRESHOLD_" in env or "MALLOC_TRIM_THRESHOLD_" in env
-            or "glibc.malloc." in env.get("GLIBC_TUNABLES", ""))
-
-
-@contextmanager
-def large_call_heap(n_faces: float) -> Iterator[bool]:
-    """Open the large-call heap scope for a call on a mesh of ``n_faces`` faces.
-
-    Yields True when the scope is active: the mesh's (#E, 3) float64 work arrays
-    (#E ≈ 1.5 #F) exceed glibc's 32 MiB dynamic mmap ceiling, :data:`LARGE_CALL_HEAP`
-    is on and no user malloc policy is set in the environment.  Nests, thread-safe."""
-    big = 1.5 * float(n_faces) * 3 * 8
-    if not LARGE_CALL_HEAP or big <= _GLIBC_MMAP_CEILING or _user_malloc_policy():
-        yield False
-        return
-    active = _core.heap_scope_enter(int(_HEAP_SCOPE_FACTOR * big))
-    try:
-        yield active
-    finally:
-        _core.heap_scope_exit()
-
-
-def _n_faces_hint(V, F):
-    """Number of faces of the call ``f(V, F, ...)`` without validating (0 if unknown)."""
-    if F is None:
-        return int(getattr(V, "n_faces", 0) or 0)
-    shape = getattr(F, "shape", None)
-    try:
-        return int(shape[0]) if shape else len(F)
-    except (TypeError, IndexError, ValueError):
-        return 0
-
-
-_P = ParamSpec("_P")
-_R = TypeVar("_R")
-
-
-def with_large_call_heap(fn: Callable[_P, _R]) -> Callable[_P, _R]:
-    """Decorator for public functions called as ``fn(V, F, ...)``: runs them inside
-    :func:`large_call_heap`.
-
-    The signature is kept for static checkers (``Callable[P, R] -> Callable[P, R]``:
-    mypy and IDEs see the decorated function's own parameters and return type) and at
-    run time (``functools.wraps``; ``inspect`` follows ``__wrapped__``)."""
-    @functools.wraps(fn)
-    def wrapper(*args: _P.args, **kwargs: _P.kwargs) -> _R:
-        V = args[0] if args else kwargs.get("V")
-        F = args[1] if len(args) > 1 else kwargs.get("F")
-        with large_call_heap(_n_faces_hint(V, F)):
-            return fn(*args, **kwargs)
-    return wrapper
+sys.modules[__name__].__class__ = _Kernels
 
 
 def topology(F, n_vertices):
@@ -401,7 +221,7 @@ def block_pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None,
     Column indices travel as int32 (memory bandwidth: the sweeps are memory-bound).  Row
     pointers: int32 when those of A and of M both are (passed without a copy, e.g.
     :func:`ell_indptr`'s), else int64.
-    Reference: :func:`igl_hhj.hhj._block_pcg`.  Preconditioner: ``M`` =
+    Reference: :func:`igl_hhj.solvers._block_pcg`.  Preconditioner: ``M`` =
     ``(indptr, indices, data)`` of a CSR matrix, else Jacobi with ``dinv``; with
     ``subdomain`` (int64 indices S) and ``subdomain_solve(r_S, z_S)`` (writes
     ``z_S = C r_S`` into its second argument, (|S|, k) float64) a second level
@@ -483,24 +303,11 @@ def face_tensors(mesh, s):
     return _core.face_tensors(mesh.V, mesh.F, _i32(mesh.face_edges), s)
 
 
-def lumped_vertex_recovery(mesh, S, N):
-    """``S_v = P_v (Σ_T |T| S_T / Σ_T |T|) P_v`` (#V, 3, 3), ``P_v = I - N_v ⊗ N_v``.
-
-    Reference: :func:`igl_hhj.curvature.vertex_shape_operator` (the lumped
-    1-ring average).  ``S`` (#F, 3, 3), ``N`` (#V, 3); NaN rows for
-    unreferenced vertices."""
-    S = _f64(S, "S", (3, 3))
-    N = _f64(N, "N", (3,))
-    if S.shape[0] != mesh.n_faces or N.shape[0] != mesh.n_vertices:
-        raise ValueError("S must be (#F, 3, 3) and N (#V, 3)")
-    return _core.lumped_vertex_recovery(mesh.V, mesh.F, S, N)
-
-
 def principal_2x2(S, N):
     """Closed-form principal curvatures/directions of tangential tensors.
 
     Reference: the numpy ``eigh`` version,
-    :func:`igl_hhj.curvature._principal_from_shape_operator_reference`.
+    ``principal_from_shape_operator_reference`` of ``tests/vertex_stage/reference_intrinsic.py``.
     ``S`` (n, 3, 3), ``N`` (n, 3) unit normals → ``PD1, PD2`` (n, 3), ``PV1 ≥ PV2`` (n,)."""
     S = _f64(S, "S", (3, 3))
     N = _f64(N, "N", (3,))
@@ -532,54 +339,11 @@ def _recovery_args(mesh, S, N, w, name):
     return S, N, w
 
 
-def patch_recovery(mesh, S, N, w, keep_trace=True):
-    """Patch recovery of face tensors at the vertices, tangent-projected, as 6 components.
-
-    Reference: :func:`igl_hhj.recovery.recover_vertex_tensors` (``method="patch"``).
-    ``S`` (#F, 3, 3), ``N`` (#V, 3) unit vertex normals, ``w`` (#F,) face weights →
-    (#V, 6) float64 in the component order of :data:`igl_hhj.recovery._SYM`
-    (rows of unreferenced vertices 0)."""
-    S, N, w = _recovery_args(mesh, S, N, w, "patch_recovery")
-    _threads()
-    return _core.patch_recovery(mesh.V, mesh.F, S, N, w, _ref_mask(mesh), float(mesh.mean_edge_length),
-                                bool(keep_trace))
-
-
-def tangent_projection6(mesh, X, N, keep_trace=True):
-    """In place on (#V, 6) components: ``P X P`` (+ the kept trace), reference
-    :func:`igl_hhj.recovery.tangent_projection`; unreferenced rows untouched."""
-    if not (isinstance(X, np.ndarray) and X.dtype == np.float64 and X.flags.c_contiguous
-            and X.shape == (mesh.n_vertices, 6)):
-        raise ValueError("tangent_projection6: X must be a C-contiguous float64 (#V, 6) array")
-    _threads()
-    _core.tangent_projection6(X, _f64(N, "N", (3,)), _ref_mask(mesh), bool(keep_trace))
-
-
-def smooth_vertex_tensors(mesh, X, C, mass, t, steps, coefficients, rtol, maxiter):
-    """Twiced implicit diffusion of the 6 tensor components ``X`` (#V, 6), in place.
-
-    Reference: :func:`igl_hhj.recovery.smooth_vertex_tensors`.  ``C`` (#F, 3) the
-    face-scaled cotangent entries, ``mass`` (#V,) the floored lumped mass, ``t`` the
-    step size, ``coefficients`` binom(order, j)(-1)^(j+1).  Returns ``(status,
-    iterations)``; status 0 when every PCG solve converged."""
-    if not (isinstance(X, np.ndarray) and X.dtype == np.float64 and X.flags.c_contiguous
-            and X.shape == (mesh.n_vertices, 6)):
-        raise ValueError("smooth_vertex_tensors: X must be a C-contiguous float64 (#V, 6) array")
-    C = _f64(C, "C", (3,))
-    mass = _f64(mass, "mass")
-    if C.shape[0] != mesh.n_faces or mass.shape != (mesh.n_vertices,):
-        raise ValueError("smooth_vertex_tensors: C must be (#F, 3) and mass (#V,)")
-    _threads()
-    return _core.smooth_vertex_tensors(_i32(mesh.edges), _i32(mesh.edge_faces), _i8(mesh.edge_local_index),
-                                       C, mass, X, float(t), int(steps), [float(c) for c in coefficients],
-                                       float(rtol), int(maxiter))
-
-
 def intrinsic_patch_recovery(mesh, S, N, w):
     """Intrinsic patch recovery: ``(X, rough)``, X (#V, 3) components ``(h, Re z, Im z)``
-    (reference :func:`igl_hhj.intrinsic.recover`, rows of unreferenced vertices 0) and
+    (reference ``recover`` of ``tests/vertex_stage/reference_intrinsic.py``, rows of unreferenced vertices 0) and
     rough (#V,) the roughness of S_h around each vertex (reference
-    :func:`igl_hhj.intrinsic.roughness`).  ``S`` (#F, 3, 3), ``N`` (#V, 3) unit vertex
+    ``roughness`` there).  ``S`` (#F, 3, 3), ``N`` (#V, 3) unit vertex
     normals, ``w`` (#F,) face weights."""
     S, N, w = _recovery_args(mesh, S, N, w, "intrinsic_patch_recovery")
     _threads()
@@ -613,15 +377,15 @@ def graph_components(pairs, n):
 
 def dihedral_magnitudes(mesh):
     """``|θ_e|`` (#E,) of every edge with exactly two faces (0 on the others); reference
-    :func:`igl_hhj.features.dihedral_magnitudes_reference`."""
+    ``tests/vertex_stage/reference_creases.py``."""
     _threads()
     return _core.dihedral_magnitudes(_f64(mesh.face_normals, "face_normals", (3,)), _i32(mesh.edge_faces),
                                      _i8(mesh.edge_face_count))
 
 
 def crease_cut(mesh, join):
-    """The cut of :func:`igl_hhj.features.cut_along` (reference
-    :func:`igl_hhj.features.cut_along_reference`): ``join`` (#E,) bool, the edges across
+    """The cut of :func:`igl_hhj.creases.cut_along` (reference
+    :func:`igl_hhj.creases.cut_along_reference`): ``join`` (#E,) bool, the edges across
     which corners stay together (two faces, not a crease).  Returns ``(Fc (#F, 3) int64,
     extra (k,) int64)``: the cut faces and the vertex of every extra side (row #V + i)."""
     join = np.ascontiguousarray(join, dtype=np.uint8)
@@ -633,7 +397,7 @@ def crease_cut(mesh, join):
 
 def transport_phases(mesh, N):
     """(#E, 2) cos and sin of the spin-2 transport of each edge; reference
-    :func:`igl_hhj.intrinsic.transport_phase_components`."""
+    :func:`igl_hhj.intrinsic_numpy.transport_phase_components`."""
     N = _f64(N, "N", (3,))
     if N.shape[0] != mesh.n_vertices:
         raise ValueError("transport_phases: N must be (#V, 3)")
@@ -659,7 +423,7 @@ def boundary_normal_fits(mesh, verts, rings, N0):
 
 
 def adaptive_radius(mesh, pilot, rough, radius, gain, power, lo, hi):
-    """Per-face smoothing radius (#F,); reference :func:`igl_hhj.intrinsic.adaptive_radius`."""
+    """Per-face smoothing radius (#F,); reference :func:`igl_hhj.intrinsic_numpy.adaptive_radius`."""
     pilot = _f64(pilot, "pilot", (3,))
     rough = _f64(rough, "rough")
     if pilot.shape[0] != mesh.n_vertices or rough.shape != (mesh.n_vertices,):
@@ -671,7 +435,8 @@ def adaptive_radius(mesh, pilot, rough, radius, gain, power, lo, hi):
 
 def principal_hz(X, N):
     """Principal directions and curvatures of components (h, Re z, Im z) (n, 3) in the frames
-    of N (n, 3): ``(PD1, PD2, PV1, PV2)``; reference :func:`igl_hhj.intrinsic.principal`."""
+    of N (n, 3): ``(PD1, PD2, PV1, PV2)``; reference ``principal`` of
+    ``tests/vertex_stage/reference_intrinsic.py``."""
     X = _f64(X, "X", (3,))
     N = _f64(N, "N", (3,))
     if X.shape[0] != N.shape[0]:
@@ -684,7 +449,7 @@ def intrinsic_smoothing(mesh, X, C, mass, phase, rough, radius, *, per_radius, p
                         gain, power, bounds, steps, coefficients, rtol, maxiter):
     """The drop-in's smoothing in one call, in place on ``X`` (#V, 3): the pilot step, the
     adaptive per-face radius, the twiced smoothing at it (reference
-    :func:`igl_hhj.intrinsic.vertex_stage_reference`).  Returns ``(status, iterations,
+    :func:`igl_hhj.intrinsic_numpy.smooth_reference`).  Returns ``(status, iterations,
     components, radius (#F,))``; status 0 when every solve converged (else X unchanged)."""
     if not (isinstance(X, np.ndarray) and X.dtype == np.float64 and X.flags.c_contiguous
             and X.shape == (mesh.n_vertices, 3)):
@@ -702,3 +467,11 @@ def intrinsic_smoothing(mesh, X, C, mass, phase, rough, radius, *, per_radius, p
                                      float(per_radius), float(pilot_radius), float(pilot_rtol), float(gain),
                                      float(power), float(bounds[0]), float(bounds[1]), int(steps),
                                      [float(c) for c in coefficients], float(rtol), int(maxiter))
+
+
+def dropin_small(V, F, N, cot, checks, smoothing, binom):
+    """The whole drop-in on a small mesh in one call (``_core/small_mesh.cpp``; the caller,
+    :func:`igl_hhj.small_mesh.try_dropin`, checks the arrays and passes the constants).
+    Returns ``(status, PD1, PD2, PV1, PV2, bad)``, status 0 when the compiled path applies.
+    Single-threaded by construction: no thread policy to apply."""
+    return _core.dropin_small(V, F, N, cot, checks, smoothing, binom)

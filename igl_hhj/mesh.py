@@ -40,7 +40,7 @@ Numerical-robustness policy (one set of limits for every solver)
   they are listed in ``bad_vertices`` (:func:`mark_bad_vertices`).
 * :class:`TriangleMesh` holds read-only copies of ``V`` and ``F``: the arrays
   cannot change after validation.
-* The topology maps are narrow (memory at the solve, issue 25): edge, face and
+* The topology maps are narrow (the memory of the drop-in's solve): edge, face and
   vertex indices in them are int32 (``edges``, ``face_edges``, ``edge_faces``), local
   indices, signs and counts int8 (``edge_local_index``, ``face_edge_sign``,
   ``edge_face_count``).  Indexing, ``np.bincount`` and scipy.sparse take them as they
@@ -58,23 +58,12 @@ import warnings
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .constants import COORDINATE_MAX, DEGENERATE_AREA_RTOL, FOLDED_NORMAL_RTOL, MIN_MESH_SIZE
+from .mesh_objects import mesh_arrays
+
 __all__ = ["TriangleMesh", "validate_mesh", "as_mesh", "mark_bad_vertices", "MeshWarning", "MeshDefectError",
-           "DEGENERATE_AREA_RTOL", "COORDINATE_MAX", "MIN_MESH_SIZE", "topology_reference"]
+           "DEGENERATE_AREA_RTOL", "COORDINATE_MAX", "MIN_MESH_SIZE"]
 
-DEGENERATE_AREA_RTOL = 1e-7
-"""A face with ``2|T| ≤ DEGENERATE_AREA_RTOL × (longest edge)²`` (smallest angle
-below ~1e-7 rad) is rejected: libigl's edge-length formulas lose all accuracy
-about a decade below (module docstring)."""
-
-COORDINATE_MAX = 1e75
-"""Largest accepted ``|coordinate|`` (squared areas overflow float64 beyond ~1e77)."""
-
-MIN_MESH_SIZE = 1e-60
-"""Smallest accepted longest edge (squared areas underflow towards subnormals below)."""
-
-FOLDED_NORMAL_RTOL = float(np.sqrt(np.finfo(np.float64).eps))
-"""A vertex has no tangent plane when ``|Σ_T |T| ν_T| ≤ FOLDED_NORMAL_RTOL Σ_T |T|``
-(the normalised direction would carry less than half the digits of float64)."""
 
 
 class MeshWarning(UserWarning):
@@ -239,7 +228,35 @@ class TriangleMesh:
     MeshWarning
         Boundary vertices that coincide exactly with other boundary vertices
         (an unwelded mesh or triangle soup: its seams count as boundary).
+
+    Notes
+    -----
+    The cached quantities, each computed on first use and then kept in the instance's
+    ``__dict__`` (:data:`CACHED` lists them; ``tests/mesh/test_mesh.py`` keeps the list
+    complete): the topology (``_topology``, one compiled pass, and its views ``edges``,
+    ``face_edges``, ``edge_face_count``, ``face_edge_sign``, ``edge_faces``,
+    ``edge_local_index``), the boundary (``boundary_edges``, ``boundary_vertices``,
+    ``has_boundary``, ``boundary_loops``), ``referenced_vertices``, the face geometry
+    (``_edge_vectors``, ``_cross``, ``face_double_areas``, ``face_areas``,
+    ``face_normals``, ``edge_lengths``, ``unique_edge_lengths``, ``edge_tangents``,
+    ``conormals``, ``barycentric_gradients``, ``mean_edge_length``, ``max_edge_length``)
+    and the vertex normals (``vertex_normals``, ``folded_vertices``).
+
+    Who fills or drops them besides first use: validation computes ``_cross`` and
+    ``face_double_areas`` in one compiled pass and drops ``_edge_vectors`` (72 B/face,
+    recomputed on demand); :meth:`release_face_cross_products` drops ``_cross``;
+    :meth:`_same_faces` (the cut of :mod:`igl_hhj.creases`) starts with the face metrics
+    of the mesh it cuts, :meth:`_with_topology` (:func:`igl_hhj.components.split_parts`)
+    with its sliced edge maps.
     """
+
+    CACHED = ("_topology", "edges", "face_edges", "edge_face_count", "face_edge_sign", "edge_faces",
+              "edge_local_index", "boundary_edges", "boundary_vertices", "has_boundary", "boundary_loops",
+              "referenced_vertices", "_edge_vectors", "_cross", "face_double_areas", "face_areas",
+              "face_normals", "edge_lengths", "unique_edge_lengths", "edge_tangents", "conormals",
+              "barycentric_gradients", "mean_edge_length", "max_edge_length", "vertex_normals",
+              "folded_vertices")
+    """The names of the cached quantities (see Notes)."""
 
     def __init__(self, V, F, *, copy=True):
         V = validate_vertices(V)
@@ -268,7 +285,7 @@ class TriangleMesh:
         """A mesh of the faces of ``mesh`` with new vertex indices ``F`` into ``V``, built
         without the checks (internal: the caller guarantees that every row of ``F`` has the
         positions of the same row of ``mesh.F`` and that the result is an oriented
-        edge-manifold mesh, as :func:`igl_hhj.features.cut_along` does).  The per-face
+        edge-manifold mesh, as :func:`igl_hhj.creases.cut_along` does).  The per-face
         metrics of ``mesh`` are reused: they depend only on the corner positions."""
         self = cls.__new__(cls)
         self._set_arrays(V, F, copy=True)
@@ -310,7 +327,7 @@ class TriangleMesh:
     # ------------------------------------------------------------ topology
     @cached_property
     def _topology(self):
-        # one compiled pass (igl_hhj.kernels.topology); reference: topology_reference
+        # one compiled pass (igl_hhj.kernels.topology); reference: tests/mesh/reference_topology.py
         from . import kernels
         out = kernels.topology(self.F, self.n_vertices)
         for a in out:
@@ -407,6 +424,14 @@ class TriangleMesh:
         c[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
         c[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
         return c
+
+    def release_face_cross_products(self):
+        """Drop the cached face cross products ``_cross`` (#F, 3), 24 B/face.
+
+        The drop-in calls it once the vertex normals are computed, before its HHJ solve
+        (the call's memory peak): the default path does not read them again.  Asked for
+        again, they are recomputed by the numpy property (equal to round-off)."""
+        self.__dict__.pop("_cross", None)
 
     @cached_property
     def face_double_areas(self):
@@ -607,7 +632,7 @@ def as_mesh(V: Any, F: ArrayLike | None = None, *, copy: bool = True) -> Triangl
 
     With ``F`` None, ``V`` may also be a mesh object of another library
     (``trimesh.Trimesh``, triangulated ``pyvista.PolyData``, ``meshio.Mesh``;
-    duck-typed by :func:`igl_hhj.interop.mesh_arrays`).  ``copy=False``: the mesh keeps
+    duck-typed by :func:`igl_hhj.mesh_objects.mesh_arrays`).  ``copy=False``: the mesh keeps
     read-only views of ``V`` and ``F`` where no conversion is needed (for a mesh that
     does not outlive the call that builds it; the caller must not modify ``V``, ``F``
     meanwhile).
@@ -615,7 +640,6 @@ def as_mesh(V: Any, F: ArrayLike | None = None, *, copy: bool = True) -> Triangl
     if isinstance(V, TriangleMesh) and F is None:
         return V
     if F is None:
-        from .interop import mesh_arrays
         arrays = mesh_arrays(V)
         if arrays is None:
             raise TypeError("F is required unless V is a TriangleMesh or a mesh object "
@@ -672,31 +696,3 @@ def per_vertex_array(mesh, values, name, shape_tail=()):
     if A.shape != want:
         raise ValueError(f"{name} must have shape {want}, got {A.shape}")
     return np.ascontiguousarray(A, dtype=np.float64)
-
-
-def topology_reference(F):
-    """The readable reference of :attr:`TriangleMesh._topology` (tests compare the two).
-
-    From ``igl.unique_edge_map``: ``EMAP[f + c*#F]`` is the edge opposite corner
-    ``c`` of face ``f``; edges are re-oriented as ``(min, max)``.
-
-    Returns ``(edges, face_edges, count, edge_faces, edge_local_index, face_edge_sign)``
-    as :func:`igl_hhj.kernels.topology` (int32 indices, int8 counts, local indices and
-    signs; libigl's int64 outputs are converted once here).
-    """
-    import igl
-    F = np.ascontiguousarray(F, dtype=np.int64)
-    nF = F.shape[0]
-    _, uE, EMAP, uEC, _ = igl.unique_edge_map(F)
-    edges = np.sort(np.asarray(uE, dtype=np.int64), axis=1)
-    face_edges = np.ascontiguousarray(np.asarray(EMAP).reshape(3, nF).T)
-    count = np.minimum(np.diff(uEC), 127).astype(np.int8)
-    src = F[:, [1, 2, 0]]
-    sign = np.where(edges[face_edges, 0] == src, 1, -1).astype(np.int8)
-    nE = edges.shape[0]
-    ef = -np.ones((nE, 2), dtype=np.int32)
-    li = -np.ones((nE, 2), dtype=np.int8)
-    col = (sign.ravel() < 0).astype(np.int64)
-    ef[face_edges.ravel(), col] = np.repeat(np.arange(nF), 3)
-    li[face_edges.ravel(), col] = np.tile(np.arange(3), nF)
-    return edges.astype(np.int32), face_edges.astype(np.int32), count, ef, li, sign

@@ -47,6 +47,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .capture import CapturedOutput
+from .errors import MeshFileError, install_hint
+
 __all__ = ["EXTRA_EXTENSIONS", "SPLIT_RULE", "PolygonSplit", "PolygonMesh", "polygon_split",
            "split_polygons", "read_polygon_mesh"]
 
@@ -190,8 +193,6 @@ class PolygonMesh:
 def _import(package, path):
     """Import an optional reader package; a ModuleNotFoundError naming the file and the fix."""
     import importlib
-
-    from .errors import install_hint
     try:
         return importlib.import_module(package)
     except ModuleNotFoundError as exc:
@@ -201,7 +202,6 @@ def _import(package, path):
 
 
 def _error(path, exc):
-    from .mesh_io import MeshFileError
     text = " ".join(str(exc).split()) or type(exc).__name__
     return MeshFileError(f"{path}: could not read it: {text[:200]}")
 
@@ -224,7 +224,7 @@ def read_polygon_mesh(path: str | os.PathLike, readers: tuple[str, ...] | None =
     ------
     ModuleNotFoundError
         None of the packages is installed (the message names the install command).
-    igl_hhj.mesh_io.MeshFileError
+    igl_hhj.errors.MeshFileError (also igl_hhj.mesh_io.MeshFileError)
         The package could not read the file, or it holds no surface cells.
     """
     path = Path(path)
@@ -256,7 +256,6 @@ def _triangles(F):
 
 def _read_trimesh(path):
     trimesh = _import("trimesh", path)
-    from .mesh_io import CapturedOutput
     try:
         with CapturedOutput():
             mesh = trimesh.load(str(path), force="mesh", process=False)
@@ -288,7 +287,6 @@ def _arrays(data, rows=None):
 def _read_pyvista(path):
     pv = _import("pyvista", path)
     from vtkmodules.util.numpy_support import vtk_to_numpy
-    from .mesh_io import CapturedOutput
     import warnings
     try:
         with warnings.catch_warnings(record=True) as caught, CapturedOutput():
@@ -328,7 +326,6 @@ def _read_pyvista(path):
 
 def _read_meshio(path):
     meshio = _import("meshio", path)
-    from .mesh_io import CapturedOutput
     try:
         with CapturedOutput():
             m = meshio.read(str(path))

@@ -1,56 +1,46 @@
-"""Vertex recovery and smoothing of a piecewise-constant tangential tensor field.
+"""The vertex stage's face weights and smoothing coefficients, and the ambient vertex recovery.
 
-The HHJ shape operator S_h (Walker, paper 000) is one symmetric tangential 3×3
-tensor per face.  The drop-in :func:`igl_hhj.principal_curvature` needs one per
-vertex, and on noisy meshes it needs a length scale.  Both are done here with a
-few sparse products:
+The HHJ shape operator S_h (Walker 2023) is one symmetric tangential 3×3 tensor per face.
+What the drop-in's intrinsic vertex stage (:mod:`igl_hhj.intrinsic`) takes from here:
 
-* **recovery** (:func:`recover_vertex_tensors`): a weighted least-squares
-  linear fit of the face values over the incident faces ("patch", default),
-  the lumped weighted L2 projection onto P1 (``S_v = Σ_T w_T S_T / Σ_T w_T``)
-  or the consistent-mass one, each vertex value projected onto its tangent
-  plane.  The face weights (:func:`recovery_weights`) are the areas, reduced
-  on slivers and their edge neighbours: a sliver accepted by validation
-  (relative area 1e-12) carries a tensor of size ~1/its height that must not
-  reach its vertices (``tests/vertex_stage/test_recovery.py`` checks |κ - 1| < 0.15 next to
-  a 1e-11 face on the unit sphere).
-* **smoothing** (:func:`smooth_vertex_tensors`): implicit diffusion steps
-  ``(M + t L) X = M X_prev`` of the six components of the ambient tensor
-  field with libigl's cotangent entries and a lumped mass (both weighted by
-  face reliability, :func:`smoothing_matrices`), combined by Tukey's twicing
-  ``2G - G²`` (bias O(ℓ⁴) instead of O(ℓ²)), then a trace-keeping projection
-  onto the vertex tangent plane keeps every tensor symmetric and tangential.
-  Its kernel has width ~ℓ; with ℓ proportional to the mesh size the bias is
-  O(h⁴) in smooth regions and the O(h) rate of S_h is kept.
+* **face weights** (:func:`recovery_weights`): the areas, reduced on slivers and their
+  edge neighbours: a sliver accepted by validation (relative area 1e-12) carries a tensor
+  of size ~1/its height that must not reach its vertices
+  (``tests/vertex_stage/test_recovery.py`` checks |κ - 1| < 0.15 next to a 1e-11 face on
+  the unit sphere); compiled as :func:`igl_hhj.kernels.recovery_weights`;
+* **smoothing coefficients** (:func:`smoothing_coefficients`): libigl's cotangent entries
+  and a lumped mass, both weighted by face reliability, the stiffness longer near an open
+  boundary (:func:`boundary_band`); the kernel ``I - (I - G)^order`` of the twiced
+  diffusion (:func:`kernel_coefficients`).
 
-Costs (``python -m igl_hhj.benchmarks.robustness --timing``) are reported in
-igl_hhj/docs/results.md, "Noisy scans and open meshes".
+The **ambient** recovery (:func:`recover_vertex_tensors`: "patch" linear fit, "lumped"
+or "consistent" L2 projection of the 3×3 tensors, projected onto the vertex plane;
+:func:`smooth_vertex_tensors`: implicit diffusion of the six tensor components at the
+global length ``ℓ = SMOOTHING_PER_RADIUS · radius · h̄``) was the drop-in's first vertex
+stage.  It is kept in numpy for comparison only: ``vertex_shape_operator(...,
+recovery="patch" | "lumped" | "consistent")`` and ``python -m igl_hhj.benchmarks.robustness``
+(the figures of docs/results.md made with it).  It is biased where the normal turns fast
+(a tube with 8 vertices around it: κ2 rises from 0 to 1.5/r) and measured less accurate than
+the intrinsic stage at radius 2 and 5 on every exact surface tried (docs/design.md).
 """
 from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
 
+from .constants import (BOUNDARY_BAND_RINGS, BOUNDARY_LENGTH_FACTOR, QUALITY_FLOOR,
+                        SMOOTHING_ORDER, SMOOTHING_PER_RADIUS, SMOOTHING_STEPS)
 from .mesh import TriangleMesh
 
 __all__ = [
-    "face_quality", "recovery_weights", "recovery_operator", "vertex_confidence", "QUALITY_FLOOR", "recover_vertex_tensors", "smooth_vertex_tensors",
-    "smoothing_length", "smoothing_matrices", "smoothing_coefficients", "recover_and_smooth", "patch_recover", "smooth_recovered", "boundary_band", "BOUNDARY_LENGTH_FACTOR", "SMOOTHING_PER_RADIUS", "SMOOTHING_STEPS", "SMOOTHING_ORDER", "tangent_projection",
+    # the intrinsic vertex stage's inputs
+    "face_quality", "recovery_weights", "QUALITY_FLOOR", "smoothing_coefficients", "boundary_band",
+    "kernel_coefficients", "BOUNDARY_LENGTH_FACTOR", "SMOOTHING_PER_RADIUS", "SMOOTHING_STEPS", "SMOOTHING_ORDER",
+    "tangent_projection",
+    # the ambient recovery (comparison)
+    "recover_vertex_tensors", "recovery_operator", "smooth_vertex_tensors", "smoothing_length", "smoothing_matrices",
 ]
 
-# Smoothing length ℓ = SMOOTHING_PER_RADIUS · radius · h̄ (h̄ = mean edge length).
-# Measured by ``python -m igl_hhj.benchmarks.robustness --sweep`` (error vs radius on
-# clean, jittered and noisy meshes).
-SMOOTHING_PER_RADIUS = 0.2
-# Near an open boundary (faces touching the 2-ring band) the smoothing length is this
-# many times longer: the diffusion sees half a neighbourhood there (natural boundary
-# condition), so with the same ℓ the boundary band keeps twice the noise.
-BOUNDARY_LENGTH_FACTOR = 2.0
-BOUNDARY_BAND_RINGS = 2
-# implicit steps per application of the diffusion (see smooth_vertex_tensors)
-SMOOTHING_STEPS = 2
-# bias-reduction order of the kernel: 1 plain diffusion G, 2 twicing 2G - G², 3: 3G - 3G² + G³
-SMOOTHING_ORDER = 2
 
 _SYM = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
 
@@ -61,10 +51,6 @@ def face_quality(mesh: TriangleMesh):
     with np.errstate(invalid="ignore", divide="ignore"):
         q = 4.0 * np.sqrt(3.0) * mesh.face_areas / l2
     return np.where(np.isfinite(q), q, 0.0)
-
-
-# Faces whose (neighbourhood) quality is below this get a weight that falls off linearly.
-QUALITY_FLOOR = 0.1
 
 
 def recovery_weights(mesh: TriangleMesh):
@@ -83,16 +69,6 @@ def recovery_weights(mesh: TriangleMesh):
                     np.where(ef[:, 1] >= 0, q[ef[:, 1]], np.inf))   # worst face at each edge
     qt = qe[mesh.face_edges].min(axis=1)
     return mesh.face_areas * np.minimum(1.0, qt / QUALITY_FLOOR)
-
-
-def vertex_confidence(mesh: TriangleMesh, weights=None):
-    """``c_v = Σ_{T∋v} w_T / Σ_{T∋v} |T|`` ∈ [0, 1]: how much of a vertex's patch is trustworthy, (#V,)."""
-    w = recovery_weights(mesh) if weights is None else weights
-    ws = mesh.sum_corners_to_vertices(np.broadcast_to(w[:, None], (mesh.n_faces, 3)))
-    a = mesh.sum_corners_to_vertices(np.broadcast_to(mesh.face_areas[:, None], (mesh.n_faces, 3)))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        c = ws / a
-    return np.where(np.isfinite(c), np.clip(c, 0.0, 1.0), 0.0)
 
 
 def tangent_projection(S, N, keep_trace=False):
@@ -143,7 +119,7 @@ def _square(A, n):
 def _solve(A, R, ref, rtol):
     """Solve on the referenced vertices (CG, Jacobi; direct if CG stalls)."""
     from .errors import SolverDidNotConverge
-    from .hhj import solve_spd
+    from .solvers import solve_spd
     X = np.full(R.shape, np.nan)
     idx = np.flatnonzero(ref)
     Ar = A if ref.all() else A[idx][:, idx]
@@ -220,7 +196,7 @@ def recovery_operator(mesh: TriangleMesh, method="patch", weights=None, normals=
     two faces) keep the lumped row.  Rows of unreferenced vertices are empty.
     ``weights`` may also be per corner, (#F, 3); ``corners=True`` returns the
     (#V × 3#F) matrix acting on per-corner values (row-major corners ``3 f + c``), as
-    :func:`igl_hhj.intrinsic.recover` needs.
+    the intrinsic recovery's numpy reference needs.
     """
     N = mesh.vertex_normals if normals is None else normals
     w = recovery_weights(mesh) if weights is None else np.asarray(weights, dtype=np.float64)
@@ -402,7 +378,7 @@ def smooth_vertex_tensors(mesh: TriangleMesh, Sv, N, length, *, steps=SMOOTHING_
     # (I - (I - G)^order) X0 = Σ_j binom(order, j) (-1)^(j+1) G^j X0
     X = np.zeros_like(X0)
     Y = X0
-    for c in _kernel_coefficients(order):
+    for c in kernel_coefficients(order):
         for _ in range(steps):
             Y = _diffuse(A, L, Y, ref, t, rtol)
         X += c * Y
@@ -411,74 +387,7 @@ def smooth_vertex_tensors(mesh: TriangleMesh, Sv, N, length, *, steps=SMOOTHING_
     return out
 
 
-def _kernel_coefficients(order):
+def kernel_coefficients(order):
     """binom(order, j) (-1)^(j+1), j = 1..order: ``I - (I - G)^order = Σ_j c_j G^j``."""
     from math import comb
     return [comb(order, j) * (-1) ** (j + 1) for j in range(1, order + 1)]
-
-
-def recover_and_smooth(mesh: TriangleMesh, S, length, *, weights=None, normals=None,
-                       steps=SMOOTHING_STEPS, order=SMOOTHING_ORDER, rtol=3e-3):
-    """Compiled patch recovery + smoothing of the drop-in (one pass each, no sparse matrices).
-
-    Equals ``smooth_vertex_tensors(mesh, *recover_vertex_tensors(mesh, S, weights=w), length,
-    weights=w)`` (the numpy reference, compared in ``tests/core/test_core.py``): the
-    patch recovery (:func:`igl_hhj.kernels.patch_recovery`), then ``steps × order``
-    Jacobi-PCG diffusion solves on the vertex graph
-    (:func:`igl_hhj.kernels.smooth_vertex_tensors`, entries from
-    :func:`smoothing_coefficients`), then the trace-keeping tangent projection.  Should a
-    diffusion solve not converge in 500 iterations, the numpy reference (which
-    falls back to a sparse factorisation) takes over.
-
-    Parameters
-    ----------
-    S : (#F, 3, 3) face tensors.
-    length : float, smoothing length ℓ ≥ 0 (0: recovery only).
-    weights : (#F,) optional, default the compiled :func:`recovery_weights`.
-    normals : (#V, 3) optional unit vertex normals (default ``mesh.vertex_normals``).
-
-    Returns
-    -------
-    Sv : (#V, 3, 3) symmetric tangential tensors (NaN rows for unreferenced vertices)
-    N : (#V, 3) the normals used
-    """
-    X, N, w = patch_recover(mesh, S, weights=weights, normals=normals)
-    return smooth_recovered(mesh, X, N, w, length, steps=steps, order=order, rtol=rtol), N
-
-
-def patch_recover(mesh: TriangleMesh, S, *, weights=None, normals=None):
-    """The compiled patch recovery of :func:`recover_and_smooth` alone.
-
-    Returns
-    -------
-    X : (#V, 6) float64, the recovered tangent-projected tensors (components ``_SYM``)
-    N : (#V, 3) the normals used, w : (#F,) the face weights used
-    """
-    from . import kernels
-    N = mesh.vertex_normals if normals is None else normals
-    w = kernels.recovery_weights(mesh, QUALITY_FLOOR) if weights is None else weights
-    return kernels.patch_recovery(mesh, S, N, w), N, w
-
-
-def smooth_recovered(mesh: TriangleMesh, X, N, w, length, *, steps=SMOOTHING_STEPS,
-                     order=SMOOTHING_ORDER, rtol=3e-3):
-    """The compiled smoothing of :func:`recover_and_smooth` on the output of
-    :func:`patch_recover` (``X`` is overwritten): ``(#V, 3, 3)`` tensors, NaN rows at
-    unreferenced vertices.  The face tensors are no longer needed here, so the drop-in
-    frees them before this, its memory peak."""
-    from . import kernels
-    if length > 0:
-        C, m = smoothing_coefficients(mesh, w)
-        status, _ = kernels.smooth_vertex_tensors(mesh, X, C, m, length ** 2 / steps, steps,
-                                                  _kernel_coefficients(order), rtol, 500)
-        del C, m
-        if status != 0:      # a diffusion solve stalled (X unchanged): the reference's direct fallback
-            Sv = np.full((mesh.n_vertices, 3, 3), np.nan)
-            ref = mesh.referenced_vertices
-            Sv[ref] = _from6(X[ref])
-            return smooth_vertex_tensors(mesh, Sv, N, length, steps=steps, order=order, rtol=rtol,
-                                         weights=w)
-        kernels.tangent_projection6(mesh, X, N)
-    Sv = _from6(X)
-    Sv[~mesh.referenced_vertices] = np.nan
-    return Sv

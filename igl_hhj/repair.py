@@ -32,14 +32,15 @@ incident area; a caller vertex without a copy gets NaN); per-face values with
 """
 from __future__ import annotations
 
-import contextvars
 import warnings
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from .mesh import MeshWarning, validate_faces, validate_vertices, zero_area_faces
+from .mesh_objects import mesh_arrays
 
 __all__ = ["RepairedMesh", "repair_mesh", "vertex_values_to_caller", "face_values_to_caller",
            "REPAIR_KINDS"]
@@ -47,9 +48,6 @@ __all__ = ["RepairedMesh", "repair_mesh", "vertex_values_to_caller", "face_value
 REPAIR_KINDS = ("repeated corner", "degenerate", "duplicate", "flipped", "non-orientable",
                 "non-manifold")
 """Keys of :attr:`RepairedMesh.summary`, in the order of the repairs."""
-
-_IN_REPAIR = contextvars.ContextVar("igl_hhj_in_repair", default=False)
-
 
 @dataclass(frozen=True)
 class RepairedMesh:
@@ -307,19 +305,17 @@ def face_values_to_caller(repaired, *arrays):
     return tuple(out)
 
 
-# --------------------------------------------------------------------------- drop-in support
-def in_repair():
-    """True inside a computation on a repaired mesh (no second repair: its errors propagate)."""
-    return _IN_REPAIR.get()
-
-
-PER_VERTEX_KWARGS = ("boundary_normals", "boundary_shape_operator", "simply_supported",
+# --------------------------------------------------------------------------- the pipeline's repair stage
+PER_VERTEX_KWARGS = ("w", "boundary_normals", "boundary_shape_operator", "simply_supported",
                      "boundary_gradient")
+"""The arguments of the public functions that hold per-vertex data (the values ``w`` of
+:func:`igl_hhj.surface_hessian` and the boundary data), mapped to the repaired vertices by
+:func:`map_vertex_kwargs`."""
 
 
-def _mesh_arrays(V, F):
+def caller_arrays(V, F):
+    """The caller's ``(V, F)``: the arrays, or those of a mesh object given alone (``F`` None)."""
     if F is None:
-        from .interop import mesh_arrays
         arrays = mesh_arrays(V)
         if arrays is None:
             raise TypeError("F is required unless V is a TriangleMesh or a mesh object "
@@ -328,7 +324,7 @@ def _mesh_arrays(V, F):
     return V, F
 
 
-def _vertex_rows(R, x, name):
+def vertex_rows(R, x, name):
     """The rows of per-vertex data ``x`` (#V, ...) for the repaired mesh's vertices."""
     x = np.asarray(x)
     if x.ndim == 0 or x.shape[0] != R.n_vertices:
@@ -337,15 +333,30 @@ def _vertex_rows(R, x, name):
     return x[R.vertex_map]
 
 
-def _map_kwargs(R, kwargs):
+def map_vertex_kwargs(R, kwargs):
+    """``kwargs`` with its per-vertex entries (:data:`PER_VERTEX_KWARGS`, when not None)
+    restricted to the repaired mesh's vertices (:func:`vertex_rows`)."""
     kw = dict(kwargs)
     for name in PER_VERTEX_KWARGS:
         if kw.get(name) is not None:
-            kw[name] = _vertex_rows(R, kw[name], name)
+            kw[name] = vertex_rows(R, kw[name], name)
     return kw
 
 
-def _warn(R, exc, what, F=None):
+@contextmanager
+def seams_not_warned():
+    """The computation on a repaired mesh: its split vertices coincide on purpose, so the
+    unwelded-seam :class:`~igl_hhj.mesh.MeshWarning` is not given (the caller gets one
+    warning, :func:`warn_repaired`)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshWarning)
+        yield
+
+
+def warn_repaired(R, exc, what, F=None, stacklevel=2):
+    """The one :class:`~igl_hhj.mesh.MeshWarning` of a repaired call: what was repaired
+    (``exc``: why the mesh was refused) before computing ``what``; with the caller's ``F``,
+    how many caller vertices lost every face."""
     lost = ""
     if F is not None:                       # caller vertices whose every face was dropped
         had = np.zeros(R.n_vertices, dtype=bool)
@@ -356,68 +367,4 @@ def _warn(R, exc, what, F=None):
     warnings.warn(f"the mesh was repaired before computing {what} (it was refused with: {exc}): "
                   f"{R.describe()}{lost}. Results are mapped back to the caller's rows; NaN rows are "
                   f"vertices (faces) left without a usable face. Repair the mesh yourself with "
-                  f"igl_hhj.repair.repair_mesh to silence this", MeshWarning, stacklevel=5)
-
-
-def _run_repaired(fn, V2, F2, args, kwargs):
-    token = _IN_REPAIR.set(True)
-    try:
-        with warnings.catch_warnings():
-            # split seams coincide on purpose: the caller gets one warning, ours
-            warnings.simplefilter("ignore", MeshWarning)
-            return fn(V2, F2, *args, **kwargs)
-    finally:
-        _IN_REPAIR.reset(token)
-
-
-def repaired_principal_curvature(fn, exc, V, F, radius, useKring, kwargs):
-    """The drop-in's path after a repairable :class:`~igl_hhj.mesh.MeshDefectError` ``exc``:
-    repair, compute ``fn`` on the repaired mesh, map back, warn once."""
-    if in_repair():
-        raise exc
-    V, F = _mesh_arrays(V, F)
-    R = repair_mesh(V, F)
-    kw = _map_kwargs(R, kwargs)
-    if len(R.F):
-        PD1, PD2, PV1, PV2, _ = _run_repaired(fn, R.V, R.F, (radius, useKring), kw)
-    else:
-        PD1 = PD2 = np.zeros((0, 3))
-        PV1 = PV2 = np.zeros(0)
-    PD1, PD2, PV1, PV2 = vertex_values_to_caller(R, PD1, PD2, PV1, PV2)
-    bad = ~(np.isfinite(PD1).all(axis=1) & np.isfinite(PD2).all(axis=1)
-            & np.isfinite(PV1) & np.isfinite(PV2))
-    for a in (PD1, PD2, PV1, PV2):
-        a[bad] = np.nan
-    _warn(R, exc, "principal curvatures", F)
-    return PD1, PD2, PV1, PV2, np.flatnonzero(bad).tolist()
-
-
-def repaired_shape_operator(fn, exc, V, F, kwargs):
-    """:func:`igl_hhj.shape_operator` with ``repair=True`` after a repairable defect:
-    per-face tensors in the caller's F order, NaN for dropped faces."""
-    if in_repair():
-        raise exc
-    R = repair_mesh(*_mesh_arrays(V, F))
-    kw = _map_kwargs(R, kwargs)
-    S = _run_repaired(fn, R.V, R.F, (), kw) if len(R.F) else np.zeros((0, 3, 3))
-    (S,) = face_values_to_caller(R, S)
-    _warn(R, exc, "the shape operator")
-    return S
-
-
-def repaired_surface_hessian(fn, exc, V, F, w, kwargs):
-    """:func:`igl_hhj.surface_hessian` with ``repair=True`` after a repairable defect:
-    ``w`` and ``boundary_gradient`` restricted to the repaired vertices, per-face
-    tensors in the caller's F order, NaN for dropped faces."""
-    if in_repair():
-        raise exc
-    R = repair_mesh(*_mesh_arrays(V, F))
-    w = _vertex_rows(R, w, "w")
-    kw = _map_kwargs(R, kwargs)
-    if len(R.F):
-        H = _run_repaired(fn, R.V, R.F, (w,), kw)
-    else:
-        H = np.zeros((0,) + np.shape(w)[1:] + (3, 3))
-    (H,) = face_values_to_caller(R, H)
-    _warn(R, exc, "the surface Hessian")
-    return H
+                  f"igl_hhj.repair.repair_mesh to silence this", MeshWarning, stacklevel=stacklevel)

@@ -26,8 +26,15 @@ the discretisation error: ``python -m igl_hhj.benchmarks.speed --rtol-study`` me
 the L2 vertex error of H against the exact surface on jittered ellipsoids (20k–328k
 faces) and Walker's sliver torus; at 1e-6 it differs from the error at 1e-12 by at
 most 0.0004 % (1e-4: up to 0.03 %, growing about 4× per refinement; 1e-3: 3.6 % at
-328k faces), for 35–50 % fewer iterations than 1e-12.  :func:`igl_hhj.hhj.solve_spd`
-keeps its own default 1e-10 (generic systems).
+328k faces), for 35–50 % fewer iterations than 1e-12.
+
+Generic SPD systems
+-------------------
+:func:`solve_spd` solves any sparse SPD system (mass matrices, the curved HHJ systems of
+:mod:`igl_hhj.curved`, the numpy reference :class:`igl_hhj.hhj.HHJProjection`) with a
+simpler rule: ``"auto"`` factorises up to :data:`SPD_AUTO_DIRECT_MAX` (50 000) unknowns,
+above runs PCG and switches after :data:`SPD_AUTO_CG_MAXITER` predicted iterations;
+default tolerance 1e-10.  The drop-in's HHJ system never goes through it.
 """
 from __future__ import annotations
 
@@ -36,7 +43,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-try:  # imported here, not in the first solve (first call ≈ later calls, issue 16)
+try:  # imported here, not in the first solve (so that a first call costs as the later ones)
     from cholespy import CholeskySolverD, MatrixType
 except ImportError:  # pragma: no cover - cholespy is a dependency
     CholeskySolverD = MatrixType = None
@@ -46,30 +53,15 @@ except ImportError:  # pragma: no cover - qdldl is a dependency
     _qdldl = None
 
 from . import kernels
+# the strategy's constants (values and the measurements behind them: igl_hhj.constants), as
+# globals of this module: a study may set e.g. ``solvers.SLIVER_ANGLE`` for the solver alone
+from .constants import (AUTO_DIRECT_MAX, CG_MAXITER, DEFAULT_RTOL, DIRECT_MAX, DIRECT_RESIDUAL_RTOL,
+                        ENVELOPE_MAX, LDL_MAX, PROBE_ITER, SLIVER_ANGLE, SLIVER_MAX_FRACTION,
+                        SPD_AUTO_CG_MAXITER, SPD_AUTO_DIRECT_MAX)
 from .errors import SolverDidNotConverge, SolverError
 
-__all__ = ["DEFAULT_RTOL", "HHJSystem", "cholesky_solve", "mass_solver", "pcg", "SolveInfo"]
+__all__ = ["DEFAULT_RTOL", "HHJSystem", "cholesky_solve", "mass_solver", "pcg", "SolveInfo", "solve_spd"]
 
-DEFAULT_RTOL = 1e-6
-# "auto": factorise without trying PCG up to this many unknowns (everything is instant there)
-AUTO_DIRECT_MAX = 3_000
-# "auto": never factorise above this many unknowns (fill and memory), PCG runs to convergence
-DIRECT_MAX = 700_000
-# "auto": PCG checks its rate this often
-PROBE_ITER = 20
-# iteration cap of "cg"
-CG_MAXITER = 5000
-# faces with a smallest angle below this (degrees) form the sliver subdomain of the
-# two-level preconditioner (exact sparse solve on their DOFs); chosen by
-# `python -m igl_hhj.benchmarks.speed --sliver-study` (0°-25° on camelhead, the bunny
-# upsampled twice, an open scan and a jittered ellipsoid: 15-20° was fastest on all four;
-# re-measured with the QDLDL sliver solve inside the PCG, 15°-30°: 20° is fastest or
-# within 8 % of 25° on all four, 30° up to 1.6x slower)
-SLIVER_ANGLE = 20.0
-# above this fraction of sliver DOFs "auto" factorises A itself: the two-level's subdomain
-# factorisation then costs a good part of the full one, with the PCG on top (open scan,
-# 52 % sliver DOFs: S_h direct 0.12 s, two-level PCG 0.15 s in `speed`; camelhead, 26 %: 0.06 / 0.06 s)
-SLIVER_MAX_FRACTION = 0.4
 
 
 class SolveInfo(dict):
@@ -93,15 +85,6 @@ def _pcg_iter_seconds(n, k):
     (Walker's sliver torus), 2 threads (``--sliver-study``; the two-level adds
     ``2|S|/n`` of this, see :meth:`HHJSystem._pcg`)."""
     return 0.6e-8 * n * (1 + k)
-
-
-# Up to this many unknowns the direct solver is QDLDL (AMD ordering + simplicial LDLᵀ, the
-# ``qdldl`` wheel); above, CHOLMOD's supernodal Cholesky (cholespy, whose bundled reference
-# BLAS makes its supernodal kernels slow on small and medium matrices).  Measured on the
-# HHJ matrices (python -m igl_hhj.benchmarks.speed --factor-study): QDLDL factorises 10k–167k
-# unknowns 1.6–3.4x faster than CHOLMOD and 1.6–4x faster than SuperLU-MMD; CHOLMOD wins
-# at 393k (2.8 s against 4.0 s).  QDLDL's solves are 2–3x slower than CHOLMOD's.
-LDL_MAX = 200_000
 
 
 def _splu(A):
@@ -196,17 +179,6 @@ def factorize(A, *, prefer_lu=False):
     return _splu(A)
 
 
-# Direct solves up to this many unknowns run the compiled dense envelope LDLᵀ
-# (:func:`igl_hhj.kernels.envelope_ldl_solve`) on the fixed-width rows, without scipy
-# sparse matrices or a QDLDL factor object: on tiny meshes their construction cost
-# 10-20x the factorisation (a 12-face cube: 0.25 ms of a 0.57 ms drop-in call).
-ENVELOPE_MAX = 700
-
-# A direct solve without pivoting is accepted when ‖A X - R‖ ≤ this × ‖R‖ per column;
-# otherwise (tiny pivots of a numerically semi-definite A) pivoted LU solves again.
-DIRECT_RESIDUAL_RTOL = 1e-8
-
-
 def cholesky_solve(A, R):
     """Solve ``A X = R`` for SPD sparse A by one sparse factorisation (:func:`factorize`).
 
@@ -296,6 +268,141 @@ def pcg(indptr, indices, data, R, *, rtol, maxiter, M=None, dinv=None, probe_ite
         if st != 0:
             break
     return X, max(its), max(statuses), relres
+
+
+def solve_spd(A, R, *, method="auto", rtol=1e-10, maxiter=None, preconditioner=None):
+    """Solve ``A X = R`` for an SPD sparse A and all columns of R at once.
+
+    Parameters
+    ----------
+    A : (n, n) scipy.sparse SPD matrix
+    R : (n,) or (n, k) right-hand sides
+    method : {"auto", "cg", "direct"}
+        "cg": the compiled fused block PCG (:func:`igl_hhj.kernels.block_pcg`)
+        over the k columns, preconditioned by ``preconditioner`` (a sparse SPD
+        approximation of A⁻¹, e.g. :func:`face_schwarz_preconditioner`) or,
+        without one, Jacobi.
+        "direct": one sparse factorisation (:func:`igl_hhj.solvers.cholesky_solve`:
+        QDLDL up to 200k unknowns, CHOLMOD via cholespy above, pivoted SuperLU when the
+        residual check fails).
+        "auto": direct up to ``SPD_AUTO_DIRECT_MAX`` (50 000) unknowns; above,
+        PCG, switching to the direct solver as soon as the measured
+        convergence rate predicts more than ``maxiter`` (default
+        ``SPD_AUTO_CG_MAXITER`` = 600) further iterations (checked every 20 iterations).
+    rtol : float
+        CG stops when ``‖r_j‖ ≤ rtol ‖R_j‖`` for every column j.  The default
+        1e-10 leaves a solver error far below every discretisation error in
+        the convergence tables (tests compare CG with the direct solve).
+    maxiter : int, optional
+        CG iteration cap (default 2000 for "cg", 600 for "auto").
+    preconditioner : (n, n) scipy.sparse matrix, optional
+        Applied as ``z = M r``.  Anything else with ``@`` (e.g. a
+        ``LinearOperator``) runs the numpy reference PCG :func:`_block_pcg`.
+
+    Raises
+    ------
+    SolverDidNotConverge
+        method="cg" and CG did not reach ``rtol`` within ``maxiter`` iterations.
+    """
+    R = np.asarray(R, dtype=np.float64)
+    vec = R.ndim == 1
+    if vec:
+        R = R[:, None]
+    n = A.shape[0]
+    if method not in ("auto", "cg", "direct"):
+        raise ValueError(f"unknown solver method {method!r}; use 'auto', 'cg' or 'direct'")
+    if method == "auto" and n <= SPD_AUTO_DIRECT_MAX:
+        method = "direct"
+    X = None
+    if maxiter is None:
+        maxiter = SPD_AUTO_CG_MAXITER if method == "auto" else 2000
+    if method in ("cg", "auto") and n > 0:
+        if preconditioner is not None and not sp.issparse(preconditioner):
+            try:
+                X = _block_pcg(sp.csr_matrix(A), R, rtol, maxiter, preconditioner)
+            except SolverDidNotConverge:
+                if method == "cg":
+                    raise
+        else:
+            Ac = sp.csr_matrix(A)
+            Mc = None
+            dinv = None
+            if preconditioner is None:
+                dinv = 1.0 / Ac.diagonal()
+            else:
+                Mc = sp.csr_matrix(preconditioner)
+                Mc = (Mc.indptr, Mc.indices, Mc.data)
+            Xc, it, status, relres = pcg(
+                Ac.indptr, Ac.indices, Ac.data, R, rtol=rtol, maxiter=maxiter, M=Mc, dinv=dinv,
+                probe_iter=20 if method == "auto" else 0, max_predicted=maxiter)
+            if status == 0:
+                X = Xc
+            elif method == "cg":
+                raise SolverDidNotConverge(
+                    f"preconditioned CG did not converge in {it} iterations "
+                    f"(relative residual {max(relres):.2e} > {rtol:.1e}); the mesh may contain "
+                    f"near-degenerate triangles. Use solver='direct' or solver='auto'.")
+    if X is None:
+        X = np.zeros_like(R) if n == 0 else cholesky_solve(A, R)
+    return X[:, 0] if vec else X
+
+
+def _block_pcg(A, R, rtol, maxiter, M=None):
+    """The numpy reference of the compiled block PCG: CG on the columns of R at once (independent recurrences,
+    shared sparse products).  Buffers are reused: at 10⁵–10⁶ unknowns each
+    iteration is memory-bound."""
+    n, k = R.shape
+    if maxiter is None:
+        maxiter = 2000
+    if M is None:
+        dinv = (1.0 / A.diagonal())[:, None]
+        def apply(r):  # noqa: E306
+            return dinv * r
+    else:
+        def apply(r):  # noqa: E306
+            return M @ r
+    tmp = np.empty((n, k))
+    ones = np.ones(n)
+
+    def coldot(a, b):  # column-wise dot products; `ones @` is a BLAS gemv, 50x faster than .sum(0)
+        np.multiply(a, b, out=tmp)
+        return ones @ tmp
+
+    X = np.zeros((n, k))
+    r = R.copy()
+    bb = coldot(R, R)
+    tol2 = (rtol ** 2) * bb
+    rr = bb
+    active = rr > tol2
+    if not active.any():
+        return X
+    z = apply(r)
+    p = z.copy()
+    rz = coldot(r, z)
+    for _ in range(maxiter):
+        q = A @ p
+        pq = coldot(p, q)
+        alpha = np.where(active, rz / np.where(active, pq, 1.0), 0.0)
+        np.multiply(p, alpha, out=tmp)
+        X += tmp
+        np.multiply(q, alpha, out=tmp)
+        r -= tmp
+        rr = coldot(r, r)
+        active = rr > tol2
+        if not active.any():
+            return X
+        z = apply(r)
+        rz_new = coldot(r, z)
+        beta = np.where(active, rz_new / np.where(active, rz, 1.0), 0.0)
+        rz = rz_new
+        p *= beta
+        p += z
+    worst = float(np.max(np.sqrt(rr / np.where(bb > 0, bb, 1.0))))
+    raise SolverDidNotConverge(
+        f"preconditioned CG did not converge in {maxiter} iterations "
+        f"(relative residual {worst:.2e} > {rtol:.1e}); the mesh may contain "
+        f"near-degenerate triangles. Use solver='direct' or solver='auto'.")
+
 
 
 class HHJSystem:

@@ -19,7 +19,7 @@ _DRIVER = r"""
 import json, os, resource, signal, sys, tempfile, time
 import numpy, scipy.sparse, scipy.sparse.linalg, igl
 import igl_hhj.cli as cli, igl_hhj.curvature, igl_hhj.baselines, igl_hhj.mesh_report
-from igl_hhj.mesh_io import _flush_c_stdio
+from igl_hhj.capture import flush_c_stdio as _flush_c_stdio
 
 class Timeout(BaseException):
     pass

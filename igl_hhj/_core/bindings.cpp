@@ -344,18 +344,6 @@ NB_MODULE(_hhj_core, m) {
         return to_numpy(std::move(H), {(size_t)nF, (size_t)k, 3, 3});
     });
 
-    m.def("lumped_vertex_recovery", [](In<double> V, In<i64> F, In<double> S, In<double> N) {
-        const i64 nF = F.shape(0), nV = V.shape(0);
-        need(S.shape(0) == (size_t)nF && N.shape(0) == (size_t)nV, "lumped_vertex_recovery: shapes");
-        std::vector<double> Sv((size_t)nV * 9);
-        {
-            nb::gil_scoped_release nogil;
-            hhj::ThreadBudget tb(0);
-            hhj::lumped_vertex_recovery(V.data(), F.data(), nF, nV, S.data(), N.data(), Sv.data());
-        }
-        return to_numpy(std::move(Sv), {(size_t)nV, 3, 3});
-    });
-
     m.def("principal_2x2", [](In<double> S, In<double> N) {
         const i64 n = N.shape(0);
         need(S.shape(0) == (size_t)n, "principal_2x2: shapes");
@@ -381,56 +369,6 @@ NB_MODULE(_hhj_core, m) {
             hhj::recovery_weights(V.data(), F.data(), nF, FE.data(), EF.data(), nE, floor, w.data(), tb.nt);
         }
         return to_numpy(std::move(w), {(size_t)nF});
-    });
-
-    m.def("patch_recovery", [](In<double> V, In<i64> F, In<double> S, In<double> N, In<double> w,
-                               In<unsigned char> ref, double h, bool keep_trace) {
-        const i64 nF = F.shape(0), nV = V.shape(0);
-        need(S.shape(0) == (size_t)nF && N.shape(0) == (size_t)nV && w.shape(0) == (size_t)nF &&
-             ref.shape(0) == (size_t)nV, "patch_recovery: shapes");
-        std::vector<double> X((size_t)nV * 6);
-        {
-            nb::gil_scoped_release nogil;
-            hhj::ThreadBudget tb(nV);
-            hhj::patch_recovery(V.data(), F.data(), nF, nV, S.data(), N.data(), w.data(), ref.data(), h,
-                                X.data(), tb.nt);
-            hhj::tangent_projection6(X.data(), N.data(), ref.data(), nV, keep_trace, tb.nt);
-        }
-        return to_numpy(std::move(X), {(size_t)nV, 6});
-    });
-
-    m.def("tangent_projection6", [](nb::ndarray<double, nb::c_contig, nb::device::cpu> X, In<double> N,
-                                    In<unsigned char> ref, bool keep_trace) {
-        const i64 n = X.shape(0);
-        need(X.ndim() == 2 && X.shape(1) == 6 && N.shape(0) == (size_t)n && ref.shape(0) == (size_t)n,
-             "tangent_projection6: shapes");
-        nb::gil_scoped_release nogil;
-        hhj::ThreadBudget tb(n);
-        hhj::tangent_projection6(X.data(), N.data(), ref.data(), n, keep_trace, tb.nt);
-    });
-
-    m.def("smooth_vertex_tensors", [](In<i32> E, In<i32> EF, In<i8> ELI, In<double> C, In<double> mass,
-                                      nb::ndarray<double, nb::c_contig, nb::device::cpu> X, double t, int steps,
-                                      std::vector<double> binom, double rtol, i64 maxiter) {
-        const i64 nV = X.shape(0), nE = E.shape(0);
-        need(X.ndim() == 2 && X.shape(1) == 6 && mass.shape(0) == (size_t)nV, "smooth_vertex_tensors: X, mass");
-        need(EF.shape(0) == (size_t)nE && ELI.shape(0) == (size_t)nE && C.ndim() == 2 && C.shape(1) == 3,
-             "smooth_vertex_tensors: topology shapes");
-        need(nV < ((i64)1 << 31), "smooth_vertex_tensors: at most 2**31 - 1 vertices");
-        const i64 nF = C.shape(0);
-        const i32* e = E.data();
-        for (i64 q = 0; q < 2 * nE; ++q) need(e[q] >= 0 && e[q] < nV, "smooth_vertex_tensors: edge index out of range");
-        for (i64 q = 0; q < 2 * nE; ++q)
-            need(EF.data()[q] < nF && ELI.data()[q] < 3, "smooth_vertex_tensors: edge_faces out of range");
-        int status;
-        i64 iterations = 0;
-        {
-            nb::gil_scoped_release nogil;
-            hhj::ThreadBudget tb(nV);
-            status = hhj::smooth_vertex_tensors(nV, E.data(), nE, EF.data(), ELI.data(), C.data(), mass.data(), t,
-                                                steps, binom, rtol, maxiter, X.data(), tb.nt, &iterations);
-        }
-        return nb::make_tuple(status, iterations);
     });
 
     m.def("intrinsic_patch_recovery", [](In<double> V, In<i64> F, In<double> S, In<double> N, In<double> w,

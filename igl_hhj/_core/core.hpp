@@ -6,7 +6,7 @@
 //   n_i = t_i x nu (outward conormal), grad lambda_i = -l_i n_i / (2|T|).
 // No hidden state: every kernel reads its inputs and writes caller-owned outputs.
 // Arrays are row-major (C-contiguous) float64 / int64; the topology maps of
-// mesh.TriangleMesh are narrow (memory, issue 25): edge, face and vertex indices in
+// mesh.TriangleMesh are narrow (memory): edge, face and vertex indices in
 // them int32 (i32), local indices, signs and incidence counts int8 (i8).  Load an
 // i32 into an i64 before multiplying it (3 * e overflows int above 715M).
 #pragma once
@@ -151,17 +151,6 @@ inline void normal_frames(const double* N, i64 nV, double* fr, int nt) {
     }
 }
 
-// out = P S P, P = I - n n^T (projection of a 3x3 tensor onto the tangent plane of unit n)
-inline void project_tangent(const double* n, const double S[3][3], double out[3][3]) {
-    double P[3][3], T[3][3];
-    for (int p = 0; p < 3; ++p)
-        for (int q = 0; q < 3; ++q) P[p][q] = (p == q ? 1.0 : 0.0) - n[p] * n[q];
-    for (int p = 0; p < 3; ++p)
-        for (int q = 0; q < 3; ++q) T[p][q] = P[p][0] * S[0][q] + P[p][1] * S[1][q] + P[p][2] * S[2][q];
-    for (int p = 0; p < 3; ++p)
-        for (int q = 0; q < 3; ++q) out[p][q] = T[p][0] * P[0][q] + T[p][1] * P[1][q] + T[p][2] * P[2][q];
-}
-
 // Face geometry of face f of (V, F), same formulas as mesh.py's properties.
 inline void face_geom(const double* V, const i64* F, i64 f, FaceGeom& g) {
     const double* x[3] = {V + 3 * F[3 * f], V + 3 * F[3 * f + 1], V + 3 * F[3 * f + 2]};
@@ -212,18 +201,12 @@ void shape_operator_faces(const double* V, const i64* F, const i32* FE, i64 nF,
                           const double* s, double* S, int nt);
 void face_tensors(const double* V, const i64* F, const i32* FE, i64 nF,
                   const double* s, int k, double* H, int nt);
-void lumped_vertex_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S,
-                            const double* N, double* Sv);
 void principal_2x2(const double* S, const double* N, i64 n, double* PD1, double* PD2,
                    double* PV1, double* PV2, int nt);
 
 // recovery_kernels.cpp
 void recovery_weights(const double* V, const i64* F, i64 nF, const i32* FE, const i32* EF, i64 nE,
                       double floor, double* w, int nt);
-void patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S, const double* N,
-                    const double* w, const unsigned char* ref, double h, double* X, int nt);
-void tangent_projection6(double* X, const double* N, const unsigned char* ref, i64 n, bool keep_trace,
-                         int nt);
 void intrinsic_patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S,
                               const double* N, const double* w, const unsigned char* ref, double h,
                               double* X, double* rough, int nt);
@@ -250,9 +233,6 @@ int intrinsic_smoothing(const double* V, const i64* F, i64 nF, i64 nV, const i32
                         double pilot_rtol, double gain, double power, double lo, double hi, int steps,
                         const std::vector<double>& binom, double rtol, i64 maxiter, double* X, double* r,
                         int nt, i64* iterations, i64* ngroups, int tasks = 1);
-int smooth_vertex_tensors(i64 nV, const i32* E, i64 nE, const i32* EF, const i8* ELI, const double* C,
-                          const double* m, double t, int steps, const std::vector<double>& binom,
-                          double rtol, i64 maxiter, double* X, int nt, i64* iterations);
 
 // pcg.cpp
 struct PCGResult {
@@ -300,8 +280,9 @@ PCGResult block_pcg(i64 n, int k, const I* Ap, const std::int32_t* Ai, const dou
 int envelope_ldl_solve(i64 n, int k, const i64* Ap, const std::int32_t* Ai, const double* Ax,
                        const double* R, double* X, double resid_rtol);
 
-// small_mesh.cpp: the drop-in on a small mesh in one call (issue 24, fixed cost).
-// The parameters are the Python constants of the general path (igl_hhj.small_mesh).
+// small_mesh.cpp: the drop-in on a small mesh in one call (the fixed cost per call).
+// The parameters are the Python constants of the general path (igl_hhj.constants, passed
+// by igl_hhj.small_mesh).
 struct SmallParams {
     double degenerate_rtol, min_mesh_size, folded_rtol, quality_floor, direct_rtol;
     i64 max_edges;            // the envelope solver's limit (solvers.ENVELOPE_MAX)

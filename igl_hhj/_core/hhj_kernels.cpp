@@ -1,7 +1,7 @@
-// The lowest-order surface HHJ layer (Walker, paper 000, §3–§5; design note
+// The lowest-order surface HHJ layer (Walker 2023, §3–§5; design note
 // hhj_lowest_order.md): local mass blocks, assembly of A, the face-Schwarz
-// preconditioner, the jump operator B, S_h per face, the lumped vertex
-// recovery and the closed-form 2x2 eigen-problem.  Loops over faces or edges
+// preconditioner, the jump operator B, S_h per face and the closed-form 2x2
+// eigen-problem.  Loops over faces or edges
 // write disjoint outputs (no atomics): results are independent of threads.
 #include <algorithm>
 
@@ -218,35 +218,6 @@ void face_tensors(const double* V, const i64* F, const i32* FE, i64 nF,
                     for (int q = 0; q < 3; ++q) out[3 * p + q] += c * phi[j][p][q];
             }
         }
-    }
-}
-
-// lumped_vertex_recovery: Sv[v] = P_v (sum_T |T| S_T / sum_T |T|) P_v, P_v = I - N_v N_v^T,
-// the sum over the faces at v (curvature.vertex_shape_operator).  S (#F,3,3), N (#V,3),
-// Sv (#V,3,3); unreferenced vertices get NaN.  Serial scatter: deterministic.
-void lumped_vertex_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S,
-                            const double* N, double* Sv) {
-    std::vector<double> acc((size_t)nV * 9, 0.0), w((size_t)nV, 0.0);
-    for (i64 f = 0; f < nF; ++f) {
-        const double* x0 = V + 3 * F[3 * f];
-        const double* x1 = V + 3 * F[3 * f + 1];
-        const double* x2 = V + 3 * F[3 * f + 2];
-        double e1[3] = {x1[0] - x0[0], x1[1] - x0[1], x1[2] - x0[2]};
-        double e2[3] = {x2[0] - x0[0], x2[1] - x0[1], x2[2] - x0[2]};
-        double c[3];
-        cross3(e1, e2, c);
-        const double area = 0.5 * std::sqrt(dot3(c, c));
-        for (int cc = 0; cc < 3; ++cc) {
-            const i64 v = F[3 * f + cc];
-            for (int p = 0; p < 9; ++p) acc[9 * v + p] += area * S[9 * f + p];
-            w[v] += area;
-        }
-    }
-    for (i64 v = 0; v < nV; ++v) {
-        double M[3][3], U[3][3];
-        for (int p = 0; p < 9; ++p) M[p / 3][p % 3] = acc[9 * v + p] / w[v];
-        project_tangent(N + 3 * v, M, U);
-        for (int p = 0; p < 9; ++p) Sv[9 * v + p] = U[p / 3][p % 3];
     }
 }
 

@@ -1,4 +1,4 @@
-// The drop-in's intrinsic smoothing (igl_hhj/intrinsic.py is the readable numpy
+// The drop-in's intrinsic smoothing (igl_hhj/intrinsic_numpy.py is the readable numpy
 // reference; tests/vertex_stage/test_intrinsic.py compares them): twiced implicit diffusion of the
 // per-vertex components X = (h, Re z, Im z), h with the scalar cotangent Laplacian and
 // the spin-2 deviator z with the connection Laplacian (L_c z)_i = sum_j w_ij (z_i -
@@ -340,7 +340,7 @@ void adaptive_radius(const double* V, const i64* F, i64 nF, i64 nV, const double
         r[f] = radius * (a[F[3 * f]] + a[F[3 * f + 1]] + a[F[3 * f + 2]]) / 3.0;
 }
 
-// principal_hz (intrinsic.principal): k1,2 = h +- |z|, PD1 = cos(phi) e1 + sin(phi) e2,
+// principal_hz (reference_intrinsic.principal, tests/vertex_stage): k1,2 = h +- |z|, PD1 = cos(phi) e1 + sin(phi) e2,
 // phi = arg(z) / 2, PD2 = N x PD1, in the frames of N (tangent_frame; +z if non-finite).
 void principal_hz(const double* X, const double* N, i64 n, double* PD1, double* PD2, double* PV1,
                   double* PV2, int nt) {
@@ -548,7 +548,7 @@ struct HZProblem {
 
 }  // namespace
 
-// intrinsic_smoothing (intrinsic.vertex_stage): the pilot (one implicit step at
+// intrinsic_smoothing (intrinsic.vertex_smoothing): the pilot (one implicit step at
 // pilot_radius, to pilot_rtol), the adaptive per-face radius (adaptive_radius, written
 // to r (#F,)), then the twiced smoothing at it, on one system structure.  Returns the
 // status of the first failed solve (1: pilot, else the final's; X unchanged) or 0.

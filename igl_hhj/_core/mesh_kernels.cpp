@@ -194,7 +194,7 @@ void vertex_area_sums(const i64* F, i64 nF, i64 nV, const double* cross, const d
         }
 }
 
-// dihedral_magnitudes (features.dihedral_magnitudes_reference): |θ_e| = atan2(|ν_0 × ν_1|,
+// dihedral_magnitudes (tests/vertex_stage/reference_creases.py): |θ_e| = atan2(|ν_0 × ν_1|,
 // ν_0 · ν_1) of the unit normals N (#F,3) of the two faces EF (#E,2) of every edge with
 // exactly two faces (count (#E,) == 2), 0 on the others; the cross product's components in
 // the order of np.cross.
@@ -215,7 +215,7 @@ void dihedral_magnitudes(const double* N, const i32* EF, const i8* count, i64 nE
     }
 }
 
-// crease_cut (features.cut_along): the sides of every vertex are the connected components of
+// crease_cut (creases.cut_along): the sides of every vertex are the connected components of
 // its corners, corners 3f+c of the two faces of an edge with join[e] != 0 being joined where
 // they hold the same vertex (union-find over the 3#F corners; components labelled in the
 // order of their smallest corner).  A vertex's primary side (largest incident area, ties to

@@ -1,11 +1,10 @@
-// Vertex recovery and smoothing of the drop-in (igl_hhj/recovery.py is the readable
-// numpy reference of every kernel here; tests/core/test_core.py compares them):
-// face reliability weights, the patch recovery (weighted linear least-squares fit
-// in each vertex's tangent frame), the trace-keeping tangent projection and the
-// twiced implicit diffusion of the six tensor components (CSR assembled from the
-// unique edges, Jacobi block PCG from pcg.cpp).  Scatters over corners run
-// serially in face order and reductions use pcg.cpp's fixed chunking, so results
-// do not depend on the thread count.
+// Vertex recovery of the drop-in: the face reliability weights (recovery.recovery_weights),
+// the intrinsic patch recovery (weighted linear least-squares fit in each vertex's tangent
+// frame of the face tensors carried there by minimal rotations; numpy reference
+// tests/vertex_stage/reference_intrinsic.py), the vertex Laplacian's CSR structure (used by
+// intrinsic_kernels.cpp) and the boundary-normal fits (boundary_estimation.py).  Scatters
+// over corners run serially in face order, so results do not depend on the thread count;
+// tests/vertex_stage/test_vertex_stage_kernels.py compares them with the references.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -15,9 +14,6 @@
 namespace hhj {
 
 namespace {
-// Symmetric tensor components in the order of recovery._SYM.
-constexpr int SYM[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
-
 inline void face_cross(const double* V, const i64* F, i64 f, double c[3]) {
     const double* x0 = V + 3 * F[3 * f];
     const double* x1 = V + 3 * F[3 * f + 1];
@@ -63,8 +59,8 @@ void recovery_weights(const double* V, const i64* F, i64 nF, const i32* FE, cons
     }
 }
 
-// The weighted least-squares linear patch fit shared by patch_recovery and
-// intrinsic_patch_recovery (recovery.recovery_operator("patch")): for every corner
+// The weighted least-squares linear patch fit of intrinsic_patch_recovery
+// (recovery.recovery_operator("patch")): for every corner
 // (f, c) of vertex v the coefficient k_{v,(f,c)} = W (g0 + g1 u + g2 v) / det of the fit
 // of a + b u + c v to the corner values at the centroid offsets (u, v) / h in v's
 // tangent frame, evaluated at the vertex; the lumped weight W / sum W where the linear
@@ -156,25 +152,10 @@ void patch_fit(const double* V, const i64* F, i64 nF, i64 nV, const double* N, c
     }
 }
 
-// patch_recovery: X[v] (6 components) = sum_{T ∋ v} k_{v,T} S_T (patch_fit with the face
-// weights w).  S (#F,9), w (#F,), h the mean edge length; X (#V,6), rows of
-// unreferenced vertices 0.
-void patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S, const double* N,
-                    const double* w, const unsigned char* ref, double h, double* X, int nt) {
-    std::fill(X, X + (size_t)nV * 6, 0.0);
-    const VertexCorners vc(F, nF, nV);
-    patch_fit(V, F, nF, nV, N, ref, h, vc, [&](i64 f, int) { return w[f]; },
-              [&](i64 f, int, i64 v, double k) {
-                  const double* Sf = S + 9 * f;
-                  for (int s = 0; s < 6; ++s) X[6 * v + s] += k * Sf[3 * SYM[s][0] + SYM[s][1]];
-              },
-              [](i64) {}, nt);
-}
-
-// intrinsic_patch_recovery (intrinsic.recover): the corner components (h, Re z, Im z) of
+// intrinsic_patch_recovery (reference_intrinsic.recover): the corner components (h, Re z, Im z) of
 // R S_T R^T in the frame of v, R the minimal rotation nu_T -> N_v (corner weight w_T
 // where nu_T . N_v > 0, else 0), fitted by patch_fit.  X (#V,3), rows of unreferenced 0.
-// rough (#V,) or nullptr: intrinsic.roughness, h_v sqrt(sum w |Y_T - X_v|^2 / sum w) over
+// rough (#V,) or nullptr: reference_intrinsic.roughness, h_v sqrt(sum w |Y_T - X_v|^2 / sum w) over
 // the corners of v (w the fit's corner weights), h_v the mean over them of the faces'
 // mean edge lengths (0 where undefined).
 void intrinsic_patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, const double* S,
@@ -247,31 +228,6 @@ void intrinsic_patch_recovery(const double* V, const i64* F, i64 nF, i64 nV, con
               nt);
 }
 
-// tangent_projection6: X[r] <- P S P (symmetrised) + keep_trace * (N^T S N) P / 2,
-// P = I - N N^T, on the 6-component rows with ref[r] set (recovery.tangent_projection);
-// other rows are left alone.
-void tangent_projection6(double* X, const double* N, const unsigned char* ref, i64 n, bool keep_trace,
-                         int nt) {
-#ifdef IGL_HHJ_OPENMP
-#pragma omp parallel for schedule(static) num_threads(nt)
-#endif
-    for (i64 r = 0; r < n; ++r) {
-        if (ref && !ref[r]) continue;
-        double S[3][3], U[3][3];
-        for (int s = 0; s < 6; ++s) S[SYM[s][0]][SYM[s][1]] = S[SYM[s][1]][SYM[s][0]] = X[6 * r + s];
-        const double* nv = N + 3 * r;
-        project_tangent(nv, S, U);
-        double nsn = 0.0;
-        if (keep_trace)
-            for (int p = 0; p < 3; ++p)
-                for (int q = 0; q < 3; ++q) nsn += nv[p] * S[p][q] * nv[q];
-        for (int s = 0; s < 6; ++s) {
-            const int p = SYM[s][0], q = SYM[s][1];
-            X[6 * r + s] = 0.5 * (U[p][q] + U[q][p]) + 0.5 * nsn * ((p == q ? 1.0 : 0.0) - nv[p] * nv[q]);
-        }
-    }
-}
-
 // vertex_laplacian: CSR structure of the vertex graph from the unique edges E (#E,2,
 // lexicographic (min, max) pairs) plus the diagonal: row v = [lower neighbours,
 // v, upper neighbours], ascending.  L values: -w_e off the diagonal, sum of the w_e
@@ -307,58 +263,6 @@ void vertex_laplacian(i64 nV, const i32* E, i64 nE, const i32* EF, const i8* ELI
     }
     if (pos_lo_out) *pos_lo_out = std::move(pos_lo);
     if (pos_hi_out) *pos_hi_out = std::move(pos_hi);
-}
-
-// smooth_vertex_tensors: (I - (I - G)^order) X on the 6 columns of X (#V,6), in place,
-// G = `steps` implicit steps (M + t L) Y = M Y_prev solved for the correction:
-// (M + t L) dY = -t L Y_prev, Jacobi block PCG to rtol (maxiter iterations), as
-// recovery.smooth_vertex_tensors.  m (#V,) the lumped mass (floored), binom the
-// coefficients binom(order, j) (-1)^(j+1), j = 1..order.  Returns 0, or the PCG
-// status of the first solve that did not converge (X is then left unchanged).
-int smooth_vertex_tensors(i64 nV, const i32* E, i64 nE, const i32* EF, const i8* ELI, const double* C,
-                          const double* m, double t, int steps, const std::vector<double>& binom,
-                          double rtol, i64 maxiter, double* X, int nt, i64* iterations) {
-    std::vector<i64> indptr, diag_pos;
-    std::vector<std::int32_t> indices;
-    std::vector<double> A;
-    vertex_laplacian(nV, E, nE, EF, ELI, C, indptr, indices, A, diag_pos);
-    // A = M + t L in place (L itself is not kept: -t L Y = M Y - A Y below)
-    std::vector<double> dinv(nV);
-    for (size_t q = 0; q < A.size(); ++q) A[q] *= t;
-    for (i64 v = 0; v < nV; ++v) {
-        A[diag_pos[v]] += m[v];
-        dinv[v] = 1.0 / A[diag_pos[v]];
-    }
-    const size_t n6 = (size_t)nV * 6;
-    // X is read-only until every solve has converged (a caller's fallback restarts from it)
-    std::vector<double> Y(X, X + n6), R(n6), dY(n6), acc6(n6, 0.0);
-    *iterations = 0;
-    for (size_t j = 0; j < binom.size(); ++j) {
-        for (int s = 0; s < steps; ++s) {
-            // R = -t L Y = M Y - A Y
-#ifdef IGL_HHJ_OPENMP
-#pragma omp parallel for schedule(static) num_threads(nt)
-#endif
-            for (i64 v = 0; v < nV; ++v) {
-                double acc[6] = {0, 0, 0, 0, 0, 0};
-                for (i64 q = indptr[v]; q < indptr[v + 1]; ++q) {
-                    const double a = A[q];
-                    const double* y = &Y[6 * (size_t)indices[q]];
-                    for (int c = 0; c < 6; ++c) acc[c] += a * y[c];
-                }
-                for (int c = 0; c < 6; ++c) R[6 * v + c] = m[v] * Y[6 * v + c] - acc[c];
-            }
-            PCGResult res = block_pcg<i64>(nV, 6, indptr.data(), indices.data(), A.data(), nullptr, nullptr,
-                                           nullptr, dinv.data(), R.data(), dY.data(), rtol, maxiter, 0,
-                                           std::numeric_limits<double>::infinity(), nt);
-            *iterations += res.iterations;
-            if (res.status != 0) return res.status;
-            for (size_t q = 0; q < n6; ++q) Y[q] += std::isfinite(dY[q]) ? dY[q] : 0.0;
-        }
-        for (size_t q = 0; q < n6; ++q) acc6[q] += binom[j] * Y[q];
-    }
-    std::copy(acc6.begin(), acc6.end(), X);
-    return 0;
 }
 
 

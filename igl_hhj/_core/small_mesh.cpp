@@ -1,13 +1,15 @@
-// The drop-in on a small closed mesh in one call (issue 24: fixed cost per call).
+// The drop-in on a small mesh in one call: stage 2 of igl_hhj/pipeline.py (the fixed cost
+// per call).
 //
 // igl_hhj.principal_curvature runs ~40 Python steps (validation, topology, the HHJ
 // system, its direct solve, S_h, the vertex stage, the eigen-problem), each a few
-// microseconds: 0.3 ms on a 12-face cube against libigl's 0.05 ms.  On a small
-// closed mesh this kernel runs the same compiled kernels in the same order with the
-// same inputs, so it returns the general path's values (tests/vertex_stage/test_small_mesh.py
-// compares them); anything else -- an open boundary, a defect the general path would
-// refuse or repair, more edges than the envelope solver takes, a solve that fails --
-// returns a nonzero status and the caller takes the general path.
+// microseconds: 0.3 ms on a 12-face cube against libigl's 0.05 ms.  On a small mesh
+// this kernel runs the same compiled kernels in the same order with the same inputs, so
+// it returns the general path's values (tests/vertex_stage/test_small_mesh.py compares
+// them); anything else -- boundary="plain" on an open mesh, a defect the general path
+// would refuse or repair, more edges than the envelope solver takes, a solve that fails
+// -- returns a nonzero status and the caller takes the general path.  The sections below
+// are the pipeline's stages 3 and 5-8 (igl_hhj/pipeline.py names them).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -61,7 +63,7 @@ bool coincident_rows(const double* V, const std::vector<i64>& rows) {
 int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0, const double* cot,
                  const SmallParams& p, double* PD1, double* PD2, double* PV1, double* PV2,
                  unsigned char* bad) {
-    // ---- the checks of TriangleMesh that the general path would fail or repair on
+    // ---- stage 3, mesh: the checks of TriangleMesh that the general path would fail or repair on
     for (i64 f = 0; f < nF; ++f) {
         const i64 a = F[3 * f], b = F[3 * f + 1], c = F[3 * f + 2];
         if (a == b || b == c || c == a) return SMALL_DEFECT;
@@ -95,7 +97,7 @@ int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0
     for (i64 v = 0; v < nV; ++v)
         if (on_boundary[v]) bverts.push_back(v);
     if (coincident_rows(V, bverts)) return SMALL_DEFECT;              // unwelded: the general path warns
-    // ---- referenced and folded vertices (TriangleMesh.folded_vertices), the normals
+    // ---- stage 3, mesh: referenced and folded vertices (TriangleMesh.folded_vertices), the normals
     std::vector<unsigned char> ref(nV, 0);
     for (i64 q = 0; q < 3 * nF; ++q) ref[F[q]] = 1;
     std::vector<double> s((size_t)nV * 3), asum(nV), N(N0, N0 + 3 * nV);
@@ -107,8 +109,8 @@ int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0
         if (!ref[v] || folded[v])
             for (int a = 0; a < 3; ++a) N[3 * v + a] = NAN;
     }
-    // ---- boundary="estimate" (boundary_estimation.estimate_boundary_normals; curvature's
-    // _boundary_partition, _normalised_boundary_normals, _boundary_rhs; hhj.clamped_load)
+    // ---- stage 5, boundary treatment: boundary="estimate" (boundary_estimation.estimate_boundary_normals;
+    // boundary.boundary_partition, normalised_boundary_normals, boundary_rhs, clamped_load)
     std::vector<double> Nb;                     // (nV, 3) clamped normals, NaN: plain edge
     std::vector<unsigned char> clamped(nE, 0);
     std::vector<i64> bface(nb), bloc(nb);       // the boundary edges' face and local index
@@ -175,7 +177,7 @@ int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0
                 for (int a = 0; a < 3; ++a) x[a] /= nn;
             }
     }
-    // ---- HHJ system in the Morton numbering and its direct solve (HHJSystem, "direct")
+    // ---- stage 6, S_h: HHJ system in the Morton numbering and its direct solve (HHJSystem, "direct")
     std::vector<i64> perm(nE), iperm(nE);
     edge_morton_order(V, nV, T.edges.data(), nE, perm.data());
     for (i64 i = 0; i < nE; ++i) iperm[perm[i]] = i;
@@ -243,7 +245,7 @@ int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0
         }
     std::vector<double> S((size_t)nF * 9);
     shape_operator_faces(V, F, T.face_edges.data(), nF, sigma.data(), S.data(), 1);   // S_h
-    // ---- the vertex stage (intrinsic.vertex_stage): recovery, then the smoothing
+    // ---- stage 7, vertex stage (intrinsic.vertex_recovery, then intrinsic.vertex_smoothing)
     std::vector<double> w(nF);
     recovery_weights(V, F, nF, T.face_edges.data(), T.edge_faces.data(), nE, p.quality_floor, w.data(), 1);
     const double h = pairwise_sum(len.data(), nE) / (double)nE;
@@ -289,8 +291,9 @@ int dropin_small(const double* V, i64 nV, const i64* F, i64 nF, const double* N0
                                                Xv.data(), r.data(), 1, &iterations, &ngroups);
         if (status != 0) return SMALL_SOLVE;
     }
+    // ---- stage 8, principal values (kernels.principal_hz)
     principal_hz(Xv.data(), N.data(), nV, PD1, PD2, PV1, PV2, 1);
-    // ---- NaN rows (curvature.dropin_vertex_values, mesh.mark_bad_vertices)
+    // ---- stage 8, NaN rows (pipeline._nan_rows, mesh.mark_bad_vertices)
     for (i64 v = 0; v < nV; ++v) {
         bool b = !ref[v] || folded[v];
         for (int a = 0; a < 3; ++a) b = b || !std::isfinite(PD1[3 * v + a]) || !std::isfinite(PD2[3 * v + a]);

@@ -146,7 +146,7 @@ def run(n=200, seed=0, mesh_dir=None, workers=(1, 2), chunks=4, workdir=None, pr
     """
     from distributed import Client
 
-    from .. import batch
+    from ..batch.run import _local_cluster, _machine_cores
     say = print if progress else (lambda *a, **k: None)
     tmp = Path(workdir) if workdir is not None else Path(tempfile.mkdtemp(prefix="igl_hhj_batch_"))
     clients = {}
@@ -159,12 +159,12 @@ def run(n=200, seed=0, mesh_dir=None, workers=(1, 2), chunks=4, workdir=None, pr
         load = os.getloadavg()[0]
         say(f"{n} meshes, {faces.sum()} faces ({faces.min()}–{faces.max()}); {len(small)} small "
             f"(≤ 5120 faces), {len(large)} of those with ≥ {LARGE_FACES} faces for the overhead; "
-            f"load average {load:.1f} on {batch._machine_cores()} cores")
-        res = {"meshes": n, "faces": int(faces.sum()), "cores": batch._machine_cores(),
+            f"load average {load:.1f} on {_machine_cores()} cores")
+        res = {"meshes": n, "faces": int(faces.sum()), "cores": _machine_cores(),
                "load_before": load, "chunks": chunks}
         for w in workers:
             t = time.perf_counter()
-            cluster = batch._local_cluster(w, 2)
+            cluster = _local_cluster(w, 2)
             clients[w] = (Client(cluster), cluster)
             res[f"startup_{w}"] = time.perf_counter() - t
 

@@ -19,7 +19,7 @@ hemisphere meshes up to ``--perf-max-vertices``, in the same run for
 (c) a plain direct sparse solve of the lumped ``K M⁻¹ K`` system
     (``scipy.sparse.linalg.spsolve``, SuperLU with its default ordering),
 (e) one sparse Cholesky factorisation (CHOLMOD via cholespy) of that lumped
-    ``K M⁻¹ K`` system alone, the yardstick of the full-mass method (issue 16:
+    ``K M⁻¹ K`` system alone, the yardstick of the full-mass method (target:
     within 2×; the ratio is printed),
 (d) ``igl.harmonic(V, F, b, g, k=2)`` against ``biharmonic_solve(..., f=0,
     mass="voronoi", g=g)`` (the same discrete problem; max difference reported).
@@ -169,8 +169,8 @@ def _plot(results, path):
     fig.canvas.draw()
     image = np.asarray(fig.canvas.buffer_rgba())
     plt.close(fig)
-    from ..viewer import _save_png
-    if not _save_png(path, image):                        # Pillow missing: matplotlib's RGB PNG
+    from ..viewer.render import save_png
+    if not save_png(path, image):                        # Pillow missing: matplotlib's RGB PNG
         import matplotlib.image
         matplotlib.image.imsave(path, image)
 

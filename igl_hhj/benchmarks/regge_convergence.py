@@ -255,8 +255,8 @@ def plot(result, path):
     fig.canvas.draw()
     image = np.asarray(fig.canvas.buffer_rgba())
     plt.close(fig)
-    from ..viewer import _save_png
-    if not _save_png(path, image):                        # Pillow missing: matplotlib's RGB PNG
+    from ..viewer.render import save_png
+    if not save_png(path, image):                        # Pillow missing: matplotlib's RGB PNG
         import matplotlib.image
         matplotlib.image.imsave(path, image)
 

@@ -1,4 +1,4 @@
-"""How many CG iterations the smoothing would take with other preconditioners (issue 25, item 3).
+"""How many CG iterations the smoothing would take with other preconditioners.
 
 The drop-in's smoothing solves ``(M + L_t) dY = -L_t Y`` with a Jacobi-preconditioned CG
 (:func:`igl_hhj.kernels.intrinsic_smoothing`); on sliver-rich real meshes it takes 100-500

@@ -95,7 +95,7 @@ def torus(n_faces, **kw):
 
 
 def _ellipsoid(faces):
-    from ..benchmarks.speed import _ellipsoid as ell
+    from .speed_meshes import _ellipsoid as ell
     return ell(faces)
 
 
@@ -191,7 +191,7 @@ def run_file(mesh, out, workers, tile_faces):
     import igl_hhj.tiled as tiled
     t = time.perf_counter()
     res = tiled.curvature_file(mesh, out, workers=workers, tile_faces=tile_faces, progress=False)
-    from ..batch import _proc_status_bytes
+    from ..batch.jobs import _proc_status_bytes
     stats = res.stats.values()
     print(json.dumps(dict(
         faces=res.n_faces, vertices=res.n_vertices, tiles=len(res.stats), seconds=time.perf_counter() - t,
@@ -256,7 +256,6 @@ def main(argv=None):
     ap.add_argument("--meshes", type=Path, default=_default_mesh_dir())
     ap.add_argument("--no-big-meshes", action="store_true", help="skip icosphere(8) and the 1.31M ellipsoid")
     ap.add_argument("--no-tight", action="store_true", help="skip the rtol=1e-12 runs")
-    ap.add_argument("--decay", nargs="*", default=None, metavar="MESH")
     ap.add_argument("--big", type=float, default=None, metavar="FACES")
     ap.add_argument("--cap", type=float, default=4 * 2**30)
     ap.add_argument("--workdir", type=Path, default=Path(tempfile.gettempdir()) / "igl_hhj_tiled_big")
@@ -267,10 +266,6 @@ def main(argv=None):
     if a.run_file:
         mesh, out, workers, tf = a.run_file
         return run_file(mesh, out, int(workers), int(tf))
-    if a.decay is not None:
-        from .tiled_decay import decay_table, markdown as decay_md
-        print(decay_md(decay_table(a.decay or None, a.meshes)))
-        return
     if a.big:
         print(json.dumps(big(int(a.big), a.cap, a.workdir, tile_faces=a.tile_faces)))
         return

@@ -1,5 +1,5 @@
 """How the cut of a tile changes the drop-in's values with the ring distance to it
-(``python -m igl_hhj.benchmarks.tiled --decay [MESH ...]``).
+(``python -m igl_hhj.benchmarks.tiled_decay [MESH ...]``).
 
 Each mesh is cut at the median of its face centroids' x; the half is computed as a
 tile (its cut keeps the smoothing's interior length, as :mod:`igl_hhj.tiled` does) and
@@ -41,7 +41,7 @@ def _smooth(mesh, X, N, w, times, steps, order, real_boundary):
     (:func:`igl_hhj.tiled._compute._uncut_coefficients`) and CHOLMOD solves (the complex
     Hermitian system as its real symmetric double)."""
     from ..intrinsic import connection_laplacians, transport_phases, vertex_frames
-    from ..recovery import _kernel_coefficients, smoothing_coefficients
+    from ..recovery import kernel_coefficients, smoothing_coefficients
     from ..tiled._compute import _uncut_coefficients
     C, m = smoothing_coefficients(mesh, w)
     if real_boundary is not None and mesh.has_boundary:
@@ -56,7 +56,7 @@ def _smooth(mesh, X, N, w, times, steps, order, real_boundary):
     n = mesh.n_vertices
     h, z = X[:, 0].copy(), np.r_[X[:, 1], X[:, 2]]
     hs, zs = np.zeros_like(h), np.zeros_like(z)
-    for c in _kernel_coefficients(order):
+    for c in kernel_coefficients(order):
         for _ in range(steps):
             h, z = solve_h(m * h), solve_z(np.r_[m, m] * z)
         hs += c * h
@@ -155,7 +155,7 @@ def generated(name):
     """The generated meshes of :data:`GENERATED`."""
     import igl
     from ..surfaces import Ellipsoid, ellipsoid_coarse, refine
-    from .speed import _open_scan
+    from .speed_meshes import _open_scan
     from .tiled import torus
     rng = np.random.default_rng(6)
     if "ellipsoid" in name:
@@ -216,3 +216,18 @@ def markdown(rows):
                    f"{r['hhj_decades_per_ring']:.2f} | {r['radius_max']:.1f}{' (b)' if r['boundary'] else ''} | "
                    f"{meas} | {r['rule']} | {ok} |")
     return "\n".join(out)
+
+
+def main(argv=None):
+    import argparse
+    from .tiled import _default_mesh_dir
+    ap = argparse.ArgumentParser(prog="python -m igl_hhj.benchmarks.tiled_decay", description=__doc__.split("\n")[0])
+    ap.add_argument("names", nargs="*", metavar="MESH",
+                    help=f"generated meshes ({', '.join(GENERATED)}) or mesh files (default: all generated and --meshes)")
+    ap.add_argument("--meshes", type=Path, default=_default_mesh_dir())
+    a = ap.parse_args(argv)
+    print(markdown(decay_table(a.names or None, a.meshes)))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,4 +1,4 @@
-"""The drop-in's vertex stage on real and thin meshes, against libigl (issue 23).
+"""The drop-in's vertex stage on real and thin meshes, against libigl.
 
 ``python -m igl_hhj.benchmarks.vertex_stage [--meshes DIR ...] [--quick] [--out DIR]``
 

@@ -1,8 +1,8 @@
-"""Walker's curved blocks (paper 000, §6, Tables 1–5, m = 2, 3): geometry of degree m,
+"""Walker's curved blocks (Walker 2023, §6, Tables 1–5, m = 2, 3): geometry of degree m,
 HHJ of degree r = m − 1, on the project's four surfaces.
 
 Used by ``python -m igl_hhj.benchmarks.walker_tables --orders 1 2 3``.  For each
-surface and order m the flat sequence of :func:`walker_tables.surface_levels` is
+surface and order m the flat sequence of :func:`walker_cases.surface_levels` is
 made curved by Walker's modified interpolant (eq. 4.14, :mod:`igl_hhj.curved`)
 of the exact element maps — the closest-point (Newton foot-point) projection for
 the torus and genus-3 surface, the vertical projection onto the graph for the
@@ -20,11 +20,10 @@ import numpy as np
 from ..convergence import eoc
 from ..curved import LagrangeSurface, shape_operator
 from ..curved.errors import shape_operator_errors
+from .walker_cases import HEAD, KEYS, _fmt, _fmt_eoc, condition_numbers, paper_comparison, surface_levels
 
 __all__ = ["PAPER_CURVED", "curved_levels", "run_curved", "format_curved_table"]
 
-KEYS = ("nu", "S", "S_inf", "kappa_a", "kappa_g")
-HEAD = ("‖ν‖L2", "‖S‖L2", "‖S‖L∞", "‖κa‖L2", "‖κg‖L2")
 _N = None
 # --------------------------------------------------------------------------------------------
 # PAPER DATA — Walker, Tables 2–5, m = 2 and m = 3 blocks: per k the errors
@@ -170,7 +169,6 @@ def curved_levels(name, n_levels, seed=0):
     """Exact surface and [(V, F, element_map)] for :meth:`LagrangeSurface.from_parametrization`."""
     if name == "dumbbell":
         return _dumbbell_maps(n_levels, seed=seed)
-    from .walker_tables import surface_levels
     surface, seq = surface_levels(name, n_levels, seed)
     out = []
     for V, F in seq:
@@ -192,7 +190,6 @@ def run_curved(surfaces, orders=(2, 3), levels=3, cond_levels=2, progress=True, 
     Returns dict (name, m) → list of per-level dicts (keys of
     :func:`igl_hhj.curved.errors.shape_operator_errors` plus ``k``, ``seconds``,
     ``cond_A``, ``cond_DA`` (NaN beyond ``cond_levels``), ``dofs``)."""
-    from .walker_tables import condition_numbers
     bar = None
     if progress:
         from tqdm.auto import tqdm
@@ -240,32 +237,6 @@ def run_curved(surfaces, orders=(2, 3), levels=3, cond_levels=2, progress=True, 
     if bar is not None:
         bar.close()
     return res
-
-
-def _fmt(x):
-    return "—" if x is None or not np.isfinite(x) else f"{x:.2e}"
-
-
-def _fmt_eoc(x):
-    return "" if x is None or not np.isfinite(x) else f" ({x:.2f})"
-
-
-def paper_comparison(ks, rows, rates, paper):
-    """One line: ours / paper per column at the last level that the paper has, and the
-    EOC differences (ours − paper) there."""
-    last = [i for i, k in enumerate(ks) if k < len(paper)]
-    if not last:
-        return "(no paper row at these levels)"
-    i = last[-1]
-    k = ks[i]
-    pe, pr = paper[k]
-    ratio = ", ".join(f"{h} {rows[i][key] / v:.2f}" for h, key, v in zip(HEAD, KEYS, pe))
-    diffs = [f"{h} {rates[key][i] - q:+.2f}" for h, key, q in zip(HEAD, KEYS, pr)
-             if q is not None and np.isfinite(rates[key][i])]
-    text = f"At k = {k}, ours / paper: {ratio}."
-    if diffs:
-        text += " EOC ours − paper: " + ", ".join(diffs) + "."
-    return text
 
 
 def format_curved_table(name, m, rows, m1_cond=None, heading="##"):

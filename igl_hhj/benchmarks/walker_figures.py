@@ -1,4 +1,4 @@
-"""Walker's Figs. 3–6 (paper 000, §6): the four test surfaces at m = 1, k = 1, coloured by
+"""Walker's Figs. 3–6 (Walker 2023, §6): the four test surfaces at m = 1, k = 1, coloured by
 the discrete Gauss curvature κ_h^g = det(S_h + ν⊗ν) (eq. 6.1), and a zoom with the
 principal directions as line segments — red d_1 (minimum curvature), black d_2
 (maximum), as in the paper's captions.
@@ -68,7 +68,8 @@ def render_figure(name, path, size=(760, 600), data=None):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ..viewer import _save_png, init
+    from ..viewer import init
+    from ..viewer.render import save_png
     fig_no, (eye, target), (zeye, ztarget, radius) = FIGURES[name]
     d = figure_data(name) if data is None else data
     V, F, kg = d["V"], d["F"], d["kg"]
@@ -119,7 +120,7 @@ def render_figure(name, path, size=(760, 600), data=None):
     fig.canvas.draw()
     img = np.asarray(fig.canvas.buffer_rgba())[..., :3]
     plt.close(fig)
-    if not _save_png(path, img):
+    if not save_png(path, img):
         raise RuntimeError("writing the figure needs Pillow")
     return d
 

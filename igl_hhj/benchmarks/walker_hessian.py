@@ -1,5 +1,5 @@
 """Walker's Theorem 4.1 measured: the curved HHJ surface Hessian of a general function
-(paper 000, eq. 4.9; ‖σ − σ̂_h‖_L2 = O(h^{r+1}) for m ≥ r + 1).
+(Walker 2023, eq. 4.9; ‖σ − σ̂_h‖_L2 = O(h^{r+1}) for m ≥ r + 1).
 
 w = exp(x) sin(y) on non-uniform sequences (the test sequences of ``tests/conftest.py``:
 jittered torus, jittered ellipsoid, jittered saddle with clamped data ξ̃ = I_h^m ∇_Γ w),

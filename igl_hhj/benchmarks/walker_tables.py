@@ -35,15 +35,11 @@ from ..curvature import shape_operator
 from ..hhj import mass_matrix
 from ..mesh import as_mesh
 from ..surfaces.boundary_data import walker_boundary_data
-from ..surfaces.dumbbell import WalkerDumbbell, dumbbell_sequence, saddle_sequence
-from ..surfaces.exact import WalkerGenus3, WalkerSaddle, WalkerTorus
-from ..surfaces.implicit_meshing import genus3_coarse, implicit_sequence, torus_mc_coarse
+from .walker_cases import (HEAD, KEYS, SURFACES, _fmt, _fmt_eoc, condition_numbers, paper_comparison,
+                           surface_levels)
 
 __all__ = ["PAPER_TABLES", "PAPER_COND", "SURFACES", "surface_levels", "condition_numbers",
            "run", "format_table", "main", "linf_entry_centroid"]
-
-KEYS = ("nu", "S", "S_inf", "kappa_a", "kappa_g")
-HEAD = ("‖ν‖L2", "‖S‖L2", "‖S‖L∞", "‖κa‖L2", "‖κg‖L2")
 
 # --------------------------------------------------------------------------------------------
 # PAPER DATA — S. W. Walker, "Approximating the shape operator with the surface HHJ element"
@@ -91,62 +87,9 @@ PAPER_COND = {
     "genus3": ((4.39e02, 3.13e01), (7.10e02, 6.23e01), (8.75e02, 1.01e02), (9.64e02, 1.31e02), (1.00e03, 1.53e02)),
 }
 
-SURFACES = ("saddle", "dumbbell", "torus", "genus3")
 # boundary treatment per case; "<surface>_plain" = the same meshes without boundary data
 BOUNDARY = {"saddle": "clamped", "dumbbell": "simply_supported", "torus": "plain", "genus3": "plain",
             "saddle_plain": "plain", "dumbbell_plain": "plain"}
-
-
-def surface_levels(name, n_levels, seed=0):
-    """Exact surface and Walker-style mesh sequence [(V_k, F_k)], k = 0..n_levels-1.
-
-    ``name`` is one of :data:`SURFACES` (a ``_plain`` suffix is accepted)."""
-    base = name[:-6] if name.endswith("_plain") else name
-    if base == "saddle":
-        return WalkerSaddle(), saddle_sequence(n_levels, seed=seed)
-    if base == "dumbbell":
-        return WalkerDumbbell(), dumbbell_sequence(n_levels, seed=seed)
-    if base == "torus":
-        s = WalkerTorus()
-        return s, implicit_sequence(*torus_mc_coarse(seed=seed), s, n_levels)
-    if base == "genus3":
-        s = WalkerGenus3()
-        return s, implicit_sequence(*genus3_coarse(seed=seed), s, n_levels)
-    raise ValueError(f"unknown surface {name!r}; use one of {SURFACES} (optionally with '_plain')")
-
-
-def condition_numbers(A, tol=1e-6):
-    """Spectral condition numbers of an SPD sparse matrix A and of D⁻¹A, D = diag(A).
-
-    κ(A) = λ_max/λ_min from ``eigsh`` (λ_max: Lanczos; λ_min: shift-invert
-    about 0 through one ``splu`` of A).  D⁻¹A is similar to the SPD matrix
-    D^-1/2 A D^-1/2, so κ(D⁻¹A) is its λ_max/λ_min, the number that governs
-    Jacobi-preconditioned CG; its shift-invert reuses the same LU
-    ((D^-1/2 A D^-1/2)⁻¹ = D^1/2 A⁻¹ D^1/2).
-
-    Returns
-    -------
-    (cond_A, cond_DA) : floats
-    """
-    import scipy.sparse as sp
-    import scipy.sparse.linalg as spla
-    A = sp.csc_matrix(A)
-    n = A.shape[0]
-    d = A.diagonal()
-    if np.any(d <= 0):
-        raise ValueError("A must be SPD (positive diagonal)")
-    s = 1.0 / np.sqrt(d)
-    Ah = sp.csc_matrix(sp.diags(s) @ A @ sp.diags(s))
-    lu = spla.splu(A)
-    inv_A = spla.LinearOperator((n, n), matvec=lambda x: lu.solve(np.asarray(x, dtype=np.float64).ravel()))
-    r = np.sqrt(d)
-    inv_Ah = spla.LinearOperator((n, n), matvec=lambda x: r * lu.solve(r * np.asarray(x, dtype=np.float64).ravel()))
-    out = []
-    for M, inv in ((A, inv_A), (Ah, inv_Ah)):
-        lmax = spla.eigsh(M, k=1, which="LA", tol=tol, return_eigenvectors=False)[0]
-        lmin = spla.eigsh(M, k=1, sigma=0.0, OPinv=inv, which="LM", tol=tol, return_eigenvectors=False)[0]
-        out.append(float(lmax / lmin))
-    return tuple(out)
 
 
 def linf_entry_centroid(V, F, S, surface):
@@ -252,14 +195,6 @@ def _min_angle(V, F):
     return float(np.min(ang))
 
 
-def _fmt(x):
-    return "—" if x is None or not np.isfinite(x) else f"{x:.2e}"
-
-
-def _fmt_eoc(x):
-    return "" if x is None or not np.isfinite(x) else f" ({x:.2f})"
-
-
 def format_table(name, rows, heading="##"):
     """Markdown table of one case in Walker's layout, the paper's m = 1 numbers beside ours.
 
@@ -288,7 +223,6 @@ def format_table(name, rows, heading="##"):
             lines.append(f"| paper {k} | {paper['faces0'] * 4 ** k} | | " + " | ".join(pcells) + " | | |")
     lines.append("")
     if not name.endswith("_plain"):
-        from .walker_curved import paper_comparison
         lines += paper_comparison(ks, rows, rates, paper["rows"]), ""
     if any(np.isfinite(r["cond_A"]) for r in rows):
         lines += [f"Condition numbers (Walker Table 1, {base}): ours κ(A) (κ(D⁻¹A), D = diag A) | paper (D = lumped A)",

@@ -4,13 +4,14 @@
 triangles through points of the element map, merges the duplicated points of
 shared edges (``igl.remove_duplicate_vertices``) and returns per-vertex values of a
 :class:`CurvedField` (averaged where elements meet) that
-:func:`igl_hhj.viewer.register_scalars` can show.
+:func:`igl_hhj.viewer.register_scalars` can show (:func:`igl_hhj.viewer.show_curved_field`
+does both).
 """
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["display_mesh", "show_field"]
+__all__ = ["display_mesh"]
 
 
 def _lattice(s):
@@ -66,13 +67,3 @@ def display_mesh(surface, field=None, subdivisions=4, exact=None):
         for k, v in raw.items():
             values[k] = np.bincount(SVJ, weights=v, minlength=len(SV)) / cnt
     return np.asarray(SV), np.asarray(SF, dtype=np.int64), values
-
-
-def show_field(surface, field, *, subdivisions=4, exact=None, name="curved", enabled="H",
-               screenshot=None, size=(1024, 768), **kwargs):
-    """Register a curved surface's field with :func:`igl_hhj.viewer.register_scalars`
-    (through :func:`display_mesh`); ``screenshot=path`` renders headless."""
-    from .. import viewer
-    V, F, values = display_mesh(surface, field, subdivisions, exact)
-    return viewer.register_scalars(V, F, values, name=name, enabled=enabled, screenshot=screenshot,
-                                   size=size, **kwargs)

@@ -1,4 +1,4 @@
-"""Walker's error norms on a curved surface Γ^m (paper 000, §6).
+"""Walker's error norms on a curved surface Γ^m (Walker 2023, §6).
 
 ``‖I_h^m u - u_h‖`` over Γ^m, with I_h^m the degree-m nodal interpolant of the
 exact field evaluated at the nodes (analytic continuation off Γ, as Walker), by

@@ -1,5 +1,5 @@
 """Heine's L2-projected Weingarten map on curved surfaces, Lagrange degree γ
-(paper 003, Def. 3.1 and 3.2).
+(Heine 2006, Def. 3.1 and 3.2).
 
 With W_h the continuous Lagrange space of degree γ on Γ^m (parametric: basis
 N_a ∘ X⁻¹ on every curved triangle) and ν_h the elementwise normal of Γ^m:
@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..hhj import solve_spd
+from ..solvers import solve_spd
 from .field import CurvedField
 from .reference import edge_node_slots, lagrange_basis, triangle_quadrature
 from .surface import ElementGeometry, LagrangeSurface

@@ -1,5 +1,5 @@
 """Walker's HHJ surface Hessian of a scalar function on a curved Lagrange surface
-(paper 000, §4.3–§4.5, eq. 4.7, 4.9 and Theorem 4.1).
+(Walker 2023, §4.3–§4.5, eq. 4.7, 4.9 and Theorem 4.1).
 
 Given the nodal values of ŵ_h ∈ W_h^m on Γ^m of order m (for a function w on Γ:
 Walker's interpolant 𝓘_h^{1,m}(w ∘ F_T), :func:`~igl_hhj.curved.modified_interpolant`,

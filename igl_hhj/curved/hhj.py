@@ -1,5 +1,5 @@
 """The surface HHJ space of degree r on curved Lagrange triangles and its two
-matrices (Walker, paper 000, §3–§5; eq. 3.8, 3.9, 3.14–3.16, 4.3, 4.7).
+matrices (Walker 2023, §3–§5; eq. 3.8, 3.9, 3.14–3.16, 4.3, 4.7).
 
 Space.  On a curved triangle with element map X: T̂ → T^m, J = ∂X/∂ξ (3×2),
 G = JᵀJ, the HHJ functions are the Piola images (eq. 3.14)
@@ -39,7 +39,7 @@ from functools import cached_property
 import numpy as np
 import scipy.sparse as sp
 
-from ..hhj import solve_spd
+from ..solvers import solve_spd
 
 from .reference import (CORNERS, EDGE_OUTWARD, EDGE_TANGENTS, lagrange_basis, lagrange_nodes,
                         line_quadrature, triangle_quadrature)

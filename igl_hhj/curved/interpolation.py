@@ -1,6 +1,6 @@
 """Placing the Lagrange nodes of a curved surface from a flat mesh and a map onto Γ.
 
-Walker (paper 000, eq. 4.14) builds the element maps as ``F_T^m = 𝓘_h^{1,m} F_T``
+Walker (2023, eq. 4.14) builds the element maps as ``F_T^m = 𝓘_h^{1,m} F_T``
 with the *modified* Lagrange interpolant 𝓘_h^{1,m} of eq. (4.2): on every flat
 triangle T^1 the degree-m polynomial matches F_T at the three vertices, its
 moments against P_{m-2} on each edge E^1 and against P_{m-3} on T^1:

@@ -1,4 +1,4 @@
-"""Walker's HHJ shape operator on curved Lagrange surfaces (paper 000, §5, eq. 5.11–5.19).
+"""Walker's HHJ shape operator on curved Lagrange surfaces (Walker 2023, §5, eq. 5.11–5.19).
 
 For k = 1, 2, 3 the HHJ projection σ_h^k ∈ V_h^m (degree r = m − 1) of the
 surface Hessian of the coordinate function id^k ∈ W_h^m solves
@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..curvature import _simply_supported_mask
+from ..boundary import simply_supported_mask
 from .field import CurvedField
 from .hhj import CurvedHHJ
 from .surface import LagrangeSurface
@@ -76,8 +76,8 @@ def shape_operator(surface, *, boundary_normals=None, boundary_shape_operator=No
     A, B = space.matrices
     mesh = surface.mesh
     bnd = np.flatnonzero(mesh.boundary_edges)
-    ss = _simply_supported_mask(mesh.edges[bnd], surface.n_nodes, boundary_normals,
-                                boundary_shape_operator, simply_supported, points="#N")
+    ss = simply_supported_mask(mesh.edges[bnd], surface.n_nodes, boundary_normals,
+                               boundary_shape_operator, simply_supported, points="#N")
     clamped_e, ss_e = bnd[~ss], bnd[ss]
     X = surface.nodes
     rhs = -(B @ X)

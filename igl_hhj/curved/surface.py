@@ -1,4 +1,4 @@
-"""Curved Lagrange triangulations Γ^m of order m = 1, 2, 3 (Walker, paper 000, §3.1 / §4.1).
+"""Curved Lagrange triangulations Γ^m of order m = 1, 2, 3 (Walker 2023, §3.1 / §4.1).
 
 Each triangle ``T^m`` is the image of the reference triangle under the degree-m
 Lagrange map ``X(ξ) = Σ_a N_a(ξ) x_a`` through its (m+1)(m+2)/2 nodes, listed in

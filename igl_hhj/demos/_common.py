@@ -109,7 +109,7 @@ def start_viewer(args):
     """The viewer module, with polyscope started for headless rendering
     (``--screenshot``) or for an interactive window."""
     from igl_hhj import viewer
-    from igl_hhj.mesh_io import CapturedOutput
+    from igl_hhj.capture import CapturedOutput
     try:
         with CapturedOutput():          # polyscope's EGL start-up chatter
             ps = viewer.init("openGL3_egl" if args.screenshot else "auto")

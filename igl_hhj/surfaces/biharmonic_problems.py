@@ -340,7 +340,7 @@ class SphericalCapProblem(BiharmonicProblem):
 
 
 def Hemisphere():
-    """Paper 001 Fig. 2: clamped hemisphere, ``u = (π/2 - θ)² θ⁵``."""
+    """Stein et al. 2022, Fig. 2: clamped hemisphere, ``u = (π/2 - θ)² θ⁵``."""
     return SphericalCapProblem(np.pi / 2)
 
 

@@ -1,4 +1,4 @@
-"""An exact surface with creases: the closed cylinder with flat caps (issue 27).
+"""An exact surface with creases: the closed cylinder with flat caps.
 
 ``x² + y² = R², |z| ≤ L/2`` plus the two discs ``|z| = L/2, x² + y² ≤ R²``.  With
 outward normals the side has κ1 = 1/R, κ2 = 0, H = 1/(2R); the caps are flat; the two

@@ -35,10 +35,10 @@ DEFAULT_TILE_FACES = 1_000_000
 
 
 def _check_options(radius, tile_faces, overlap, eps, rtol, solver, boundary, workers):
-    from ..boundary_estimation import BOUNDARY_TREATMENTS
-    from ..curvature import _check_rtol, check_principal_curvature_args
+    from ..constants import BOUNDARY_TREATMENTS
+    from ..pipeline import check_principal_curvature_args, check_rtol
     check_principal_curvature_args(radius, True)
-    _check_rtol(rtol)
+    check_rtol(rtol)
     for name, x, lo in (("tile_faces", tile_faces, 1), ("overlap", overlap, 0), ("workers", workers, 0)):
         if x is None and name != "tile_faces":
             continue
@@ -206,15 +206,15 @@ def principal_curvature(V: Any, F: Any = None, radius: float = 5, useKring: bool
     (True, [])
     """
     from ..mesh import validate_faces, validate_vertices
-    from ..repair import _mesh_arrays
+    from ..repair import caller_arrays
     from .partition import plan_tiles
     from .runner import open_client, run_tiles
     from .source import ArraySource, NpySource
     from .store import ArrayStore, FileStore
-    from ..curvature import check_principal_curvature_args
+    from ..pipeline import check_principal_curvature_args
     check_principal_curvature_args(radius, useKring)
     _check_options(radius, tile_faces, overlap, eps, rtol, solver, boundary, workers)
-    V, F = _mesh_arrays(V, F)
+    V, F = caller_arrays(V, F)
     V = validate_vertices(V)
     F = validate_faces(F, len(V), repeated_ok=True)
     params = _params(radius, rtol, solver, boundary, eps, overlap)

@@ -2,8 +2,9 @@
 
 :func:`tile_values` is the one place where a tile is computed; it takes a ``params``
 dict so that a second pass (global parameters reduced from a first pass over the
-cores) only adds keys.  It runs the steps of :func:`igl_hhj.curvature.dropin_on_mesh`
-and :func:`igl_hhj.intrinsic.vertex_stage` on the tile and returns, with the values,
+cores) only adds keys.  It runs stages 5-8 of the drop-in (:func:`igl_hhj.pipeline.dropin_on_mesh`:
+boundary treatment, S_h per solve group, the vertex stage of :mod:`igl_hhj.intrinsic`, principal
+values and NaN rows) on the tile and returns, with the values,
 the per-face smoothing radius r_T the stage used: the overlap rule
 (:mod:`igl_hhj.tiled.reach`) needs it, and the drop-in reports only its median.  The
 tests compare the tiled values with :func:`igl_hhj.principal_curvature` on the whole
@@ -43,7 +44,8 @@ def _uncut_coefficients(mesh, C0, real_boundary):
     of a jittered torus).  The factor is divided out on faces that are near the cut but
     not near a real boundary: exact (a power of two), and the core, ``rings`` away,
     changes by less than the rule's ε."""
-    from ..recovery import BOUNDARY_BAND_RINGS, BOUNDARY_LENGTH_FACTOR, boundary_band
+    from ..constants import BOUNDARY_BAND_RINGS, BOUNDARY_LENGTH_FACTOR
+    from ..recovery import boundary_band
     F = mesh.F
     near_any = boundary_band(mesh)[F].any(axis=1)
     near_real = _band(mesh, real_boundary, BOUNDARY_BAND_RINGS)[F].any(axis=1)
@@ -53,38 +55,40 @@ def _uncut_coefficients(mesh, C0, real_boundary):
 
 
 def _vertex_stage(mesh, S, radius, rtol, real_boundary=None):
-    """:func:`igl_hhj.intrinsic.vertex_stage` (one smoothing call for the mesh) returning
-    the per-face radius too: ``(X, N, r (#F,))``; ``real_boundary`` (#V,) bool: the
-    vertices on a boundary of the mesh (the others on the tile's boundary are on the cut,
-    :func:`_uncut_coefficients`), None: all."""
+    """Stage 7 of :func:`igl_hhj.pipeline.dropin_on_mesh` (:func:`igl_hhj.intrinsic.vertex_recovery`,
+    then the smoothing of :func:`igl_hhj.intrinsic.vertex_smoothing` in one call for the mesh)
+    returning the per-face radius too: ``(X, N, r (#F,))``; ``S`` is freed between the two.
+    ``real_boundary`` (#V,) bool: the vertices on a boundary of the mesh (the others on the
+    tile's boundary are on the cut, :func:`_uncut_coefficients`), None: all."""
     from .. import intrinsic, kernels
-    from ..recovery import QUALITY_FLOOR, smoothing_coefficients
-    N = mesh.vertex_normals
-    w = kernels.recovery_weights(mesh, QUALITY_FLOOR)
-    X, rough = kernels.intrinsic_patch_recovery(mesh, S.pop(), N, w)
+    from ..recovery import smoothing_coefficients
+    X, rough, N, w = intrinsic.vertex_recovery(mesh, S)
+    del S
     C0, m = smoothing_coefficients(mesh, w)
     if real_boundary is not None and mesh.has_boundary:
         C0 = _uncut_coefficients(mesh, C0, real_boundary)
     phase = kernels.transport_phases(mesh, N)
     status, _, _, r = intrinsic.adaptive_smoothing(mesh, X, C0, m, phase, rough, radius, rtol)
-    if status != 0:          # a solve stalled: the direct reference, as the drop-in
-        X = intrinsic._smooth_reference(mesh, X, N, w, rough, radius)
+    if status != 0:          # a solve stalled: the sparse-LU smoothing, as the drop-in
+        X = intrinsic.smooth_reference(mesh, X, N, w, rough, radius)
     return X, N, r
 
 
 def _on_mesh(mesh, params, real_boundary=None):
-    """The drop-in on a validated mesh: ``(PD1, PD2, PV1, PV2, bad list, r (#F,))``."""
+    """Stages 5-8 of the drop-in on a validated mesh: ``(PD1, PD2, PV1, PV2, bad list, r (#F,))``."""
     from .. import kernels
-    from ..curvature import _check_rtol, _resolve_boundary, _shape_operator
+    from ..boundary import resolve_boundary
     from ..mesh import mark_bad_vertices
-    rtol = _check_rtol(params["rtol"])
-    normals, treatment = _resolve_boundary(mesh, params["boundary"], None, None)
+    from ..pipeline import check_rtol, face_shape_operator
+    rtol = check_rtol(params["rtol"])
+    normals, treatment = resolve_boundary(mesh, params["boundary"], None, None)       # 5.
     mesh.vertex_normals                      # then release the cross products (the peak)
-    mesh.__dict__.pop("_cross", None)
-    holder = [_shape_operator(mesh, normals, None, None, params["solver"], rtol,
-                              estimated=treatment == "estimate")]
-    X, N, r = _vertex_stage(mesh, holder, params["radius"], rtol, real_boundary)
-    PD1, PD2, PV1, PV2 = kernels.principal_hz(X, N)
+    mesh.release_face_cross_products()
+    S = face_shape_operator(mesh, normals, None, None, params["solver"], rtol,            # 6.
+                            estimated=treatment == "estimate")
+    X, N, r = _vertex_stage(mesh, S, params["radius"], rtol, real_boundary)             # 7.
+    del S
+    PD1, PD2, PV1, PV2 = kernels.principal_hz(X, N)                                    # 8.
     del X                                    # NaN rows: unreferenced, no tangent plane
     return (*mark_bad_vertices(mesh, PD1, PD2, PV1, PV2, copy=False), r)
 
@@ -113,12 +117,12 @@ def tile_values(V, F, params, real_boundary=None):
         ``warnings``: the messages of the warnings the computation raised (a repair's
         :class:`igl_hhj.mesh.MeshWarning`), in order, without duplicates.
     """
-    from .. import kernels
+    from .. import kernels, repair
     from ..mesh import MeshDefectError, as_mesh
-    from ..repair import repaired_principal_curvature
+    from ..pipeline import on_repaired_mesh
     radius_of = []
 
-    def on_arrays(V2, F2, radius, useKring, **_):
+    def on_arrays(V2, F2, data):
         out = _on_mesh(as_mesh(V2, F2, copy=False), params)
         radius_of.append(out[-1])
         return out[:-1]
@@ -127,10 +131,15 @@ def tile_values(V, F, params, real_boundary=None):
         warnings.simplefilter("always")
         try:
             mesh = as_mesh(V, F, copy=False)
-        except MeshDefectError as exc:         # repairable: as the drop-in (issue 24)
-            kw = dict(boundary=params["boundary"], solver=params["solver"], rtol=params["rtol"])
-            PD1, PD2, PV1, PV2, _ = repaired_principal_curvature(
-                on_arrays, exc, V, F, params["radius"], True, kw)
+        except MeshDefectError as exc:         # repairable: as the drop-in (stage 3 | repair)
+            data = dict(boundary_normals=None, boundary_shape_operator=None, simply_supported=None)
+            R, out = on_repaired_mesh(exc, V, F, data, on_arrays, "principal curvatures", count_lost=True)
+            PD1, PD2, PV1, PV2 = out[:4] if out is not None else (np.zeros((0, 3)),) * 2 + (np.zeros(0),) * 2
+            PD1, PD2, PV1, PV2 = repair.vertex_values_to_caller(R, PD1, PD2, PV1, PV2)
+            bad = ~(np.isfinite(PD1).all(axis=1) & np.isfinite(PD2).all(axis=1) & np.isfinite(PV1)
+                    & np.isfinite(PV2))
+            for a in (PD1, PD2, PV1, PV2):
+                a[bad] = np.nan
             rmax = float(np.max(radius_of[0])) if radius_of and len(radius_of[0]) else 0.0
             r = np.full(len(F), rmax)
         else:

@@ -10,8 +10,8 @@ _NOT_TILED = (("method", "hhj", "--method"), ("per", "vertex", "--per"), ("featu
 
 def run(args, say=print):
     """Run the tiled computation of ``args`` (the parsed ``curvature`` command); returns 0."""
-    from ..cli import EXIT_UNREADABLE, UserError
-    from ..mesh_io import MeshFileError
+    from ..cli._common import EXIT_UNREADABLE, UserError
+    from ..errors import MeshFileError
     from . import curvature_file
     for name, default, flag in _NOT_TILED:
         if getattr(args, name, default) != default:

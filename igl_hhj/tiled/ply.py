@@ -52,7 +52,7 @@ class PlyLayout:
 
 
 def _record_dtype(order, props, corners=None):
-    from ..mesh_io import _PLY_SIZES, _ply_scalar
+    from ..mesh_io.ply import _PLY_SIZES, _ply_scalar
     fields = []
     for pname, types in props:
         if types[0] == "list":
@@ -79,7 +79,8 @@ def ply_layout(path) -> PlyLayout | None:
         records whose corner counts differ from the one the file size implies (first
         such face named; checked in blocks, so memory stays bounded).
     """
-    from ..mesh_io import MeshFileError, _parse_ply_header
+    from ..mesh_io.ply import _parse_ply_header
+    from ..errors import MeshFileError
     path = str(path)
     with open(path, "rb") as fh:
         head = fh.read(1 << 16)
@@ -120,7 +121,7 @@ def ply_layout(path) -> PlyLayout | None:
 
 def _check_counts(layout, block=1 << 22):
     """Every face record declares ``layout.corners`` corners (in blocks of ``block`` records)."""
-    from ..mesh_io import MeshFileError
+    from ..errors import MeshFileError
     for a in range(0, layout.n_polygons, block):
         b = min(a + block, layout.n_polygons)
         rec = np.memmap(layout.path, dtype=layout.face_dtype, mode="r",
@@ -136,7 +137,7 @@ def _check_counts(layout, block=1 << 22):
 
 def _text_lines(fh, n, what, path):
     """Yield blocks of up to BLOCK_LINES non-empty, non-comment lines (bytes), n lines in all."""
-    from ..mesh_io import MeshFileError
+    from ..errors import MeshFileError
     left = n
     while left > 0:
         lines = []
@@ -152,7 +153,7 @@ def _text_lines(fh, n, what, path):
 
 
 def _numbers(lines, width, what, path, first):
-    from ..mesh_io import MeshFileError
+    from ..errors import MeshFileError
     try:
         a = np.array(b" ".join(lines).split(), dtype=np.float64)
     except ValueError:
@@ -168,7 +169,7 @@ def convert_text_mesh(path, v_out, f_out):
     ``f_out`` (#F, 3) int64 ``.npy`` files in one streaming pass (k-gons: fans).
 
     Returns ``(n_vertices, n_faces)``, or None when the file is not such a mesh (read it whole)."""
-    from ..mesh_io import _parse_ply_header
+    from ..mesh_io.ply import _parse_ply_header
     path = str(path)
     with open(path, "rb") as fh:
         head = fh.read(1 << 16)

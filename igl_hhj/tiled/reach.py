@@ -8,7 +8,7 @@ open boundary, and the values in the core feel it through two chains of solves:
   unknown per edge, coupled through faces); the inverse of such a matrix decays
   exponentially with the graph distance.  The change of S_h caused by the cut,
   relative to the largest |S_h|, falls by at least :data:`HHJ_DECADES_PER_RING`
-  decades per ring (measured: ``python -m igl_hhj.benchmarks.tiled --decay``), so
+  decades per ring (measured: ``python -m igl_hhj.benchmarks.tiled_decay``), so
   after ``k_S = ⌈log10(A/ε) / HHJ_DECADES_PER_RING⌉`` rings a change of A × max(abs(κ))
   at the cut is below ε (A = :data:`CUT_AMPLITUDE`).
 * **the vertex stage's smoothing.**  ``steps × order`` implicit diffusion solves
@@ -45,7 +45,7 @@ DEFAULT_TOLERANCE = 1e-6
 
 HHJ_DECADES_PER_RING = 0.4
 """Slowest measured decay of the cut's effect on S_h, in decades per vertex ring (direct
-solves, half-space cuts; ``python -m igl_hhj.benchmarks.tiled --decay``): 0.86–0.89 on
+solves, half-space cuts; ``python -m igl_hhj.benchmarks.tiled_decay``): 0.86–0.89 on
 jittered and noisy ellipsoids, 0.5–1.4 on real meshes, 0.40 on ``beetle.off`` (a scan
 with slivers, the slowest of the 15 measured)."""
 
@@ -91,8 +91,8 @@ def smoothing_rings(radius: float, eps: float = DEFAULT_TOLERANCE, *, boundary: 
 
     ``radius``: the largest per-face radius r_T of the vertex stage between the cut and
     the core (0: no smoothing); ``boundary``: those faces touch a real open boundary."""
-    from ..intrinsic import SMOOTHING_ORDER, SMOOTHING_STEPS
-    from ..recovery import BOUNDARY_LENGTH_FACTOR, SMOOTHING_PER_RADIUS
+    from ..constants import SMOOTHING_ORDER, SMOOTHING_STEPS
+    from ..constants import BOUNDARY_LENGTH_FACTOR, SMOOTHING_PER_RADIUS
     if not radius > 0:
         return 0
     n = SMOOTHING_STEPS * SMOOTHING_ORDER
@@ -127,5 +127,5 @@ def overlap_rings(radius: float, eps: float = DEFAULT_TOLERANCE, *, boundary: bo
 def radius_bound(radius: float) -> float:
     """The largest per-face radius the vertex stage can choose at the caller's ``radius``
     (``radius × ADAPTIVE_RANGE[1]``: 25 rings at the default 5)."""
-    from ..intrinsic import ADAPTIVE_RANGE
+    from ..constants import ADAPTIVE_RANGE
     return float(radius) * float(ADAPTIVE_RANGE[1])

@@ -103,7 +103,7 @@ def open_client(client=None, scheduler=None, workers=None, retries=2, n_tasks=No
             raise ValueError(f"cannot connect to the Dask scheduler at {scheduler}: "
                              f"{' '.join(str(exc).split())[:200]}") from None
         return c, [c]
-    from ..batch import _local_cluster, _machine_cores
+    from ..batch.run import _local_cluster, _machine_cores
     n = workers or _machine_cores()
     if n_tasks:
         n = max(1, min(n, n_tasks))

@@ -141,7 +141,8 @@ def open_mesh_file(path, workdir) -> tuple[MeshSource, str]:
     read whole by :func:`igl_hhj.mesh_io.read_mesh` and written to ``workdir``
     (``"read whole"``).
     """
-    from ..mesh_io import MeshFileError, read_mesh
+    from ..errors import MeshFileError
+    from ..mesh_io import read_mesh
     path = str(path)
     if not os.path.isfile(path):
         raise MeshFileError(f"{path}: no such file")

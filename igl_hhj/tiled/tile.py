@@ -102,7 +102,7 @@ def grown_tile(source, plan, t, rings) -> GrownTile:
 
 def _peak_rss():
     """Peak resident memory of this process in bytes (Linux ``VmHWM``; 0 when unknown)."""
-    from ..batch import _proc_status_bytes
+    from ..batch.jobs import _proc_status_bytes
     return _proc_status_bytes("VmHWM") or 0
 
 

@@ -172,7 +172,7 @@ def test_in_process_formats_and_options(collection, tmp_path, capsys):
 @pytest.mark.slow
 def test_user_errors(collection, tmp_path, capsys, monkeypatch):
     folder, good, _ = collection
-    assert [cli._memory_bytes(t) for t in ("4G", "512MiB", "2e9", "1500k")] == \
+    assert [cli.batch._memory_bytes(t) for t in ("4G", "512MiB", "2e9", "1500k")] == \
         [4_000_000_000, 512 * 2**20, 2_000_000_000, 1_500_000]
     with monkeypatch.context() as m:
         m.setitem(sys.modules, "meshio", None)           # meshio not installed: vtu / vtp still work
@@ -484,10 +484,10 @@ def test_pending_options_entry_dates_the_output(tmp_path):
     out.write_bytes(b"x")
     key = batch.options_key("igl", "vertex", None)
     mtime = os.stat(out).st_mtime_ns
-    assert batch._made_with({"options": key, "done": False, "t": mtime - 1}, str(out)) == key
-    assert batch._made_with({"options": key, "done": False, "t": mtime + 1}, str(out)) is None
-    assert batch._made_with({"options": key, "done": True, "t": mtime + 1}, str(out)) == key
-    assert batch._made_with(None, str(out)) is None and batch._made_with("junk", str(out)) is None
+    assert batch.resume._made_with({"options": key, "done": False, "t": mtime - 1}, str(out)) == key
+    assert batch.resume._made_with({"options": key, "done": False, "t": mtime + 1}, str(out)) is None
+    assert batch.resume._made_with({"options": key, "done": True, "t": mtime + 1}, str(out)) == key
+    assert batch.resume._made_with(None, str(out)) is None and batch.resume._made_with("junk", str(out)) is None
 
 
 # --------------------------------------------------------------------------- warnings (issue 26)

@@ -236,7 +236,8 @@ def test_progress_lines_only_for_large_meshes(sphere, tmp_path, monkeypatch, cap
     out = str(tmp_path / "k.csv")
     assert cli.main(["curvature", str(path), "-o", out]) == 0
     assert capsys.readouterr().err == ""
-    monkeypatch.setattr(cli, "LARGE_MESH_FACES", 100)
+    from igl_hhj.cli import curvature as curvature_command
+    monkeypatch.setattr(curvature_command, "LARGE_MESH_FACES", 100)     # what the command reads
     assert cli.main(["curvature", str(path), "-o", out]) == 0
     err = capsys.readouterr().err.splitlines()
     assert [ln[:5] for ln in err] == ["[1/3]", "[2/3]", "[3/3]"]
@@ -251,7 +252,8 @@ def test_output_errors_come_before_computing(sphere, tmp_path, monkeypatch, caps
     def must_not_run(*args, **kwargs):
         raise AssertionError("computed before checking the output")
     monkeypatch.setattr(baselines, "estimate", must_not_run)
-    monkeypatch.setattr(cli, "_read", must_not_run)
+    from igl_hhj.cli import curvature as curvature_command
+    monkeypatch.setattr(curvature_command, "_read", must_not_run)       # the name the command calls
     for out in ["/nonexistent/dir/x.npz", str(tmp_path / "x.txt"), str(tmp_path)]:
         assert cli.main(["curvature", str(path), "-o", out]) == 2
         one_error_line(capsys.readouterr().err)
@@ -345,7 +347,7 @@ def test_screenshot_without_matplotlib_warns_and_keeps_a_colour_bar(sphere, tmp_
     with warnings.catch_warnings():
         warnings.simplefilter("always")
         with pytest.warns(UserWarning, match="held back"):
-            assert cli._quietly(lambda: warnings.warn("held back") or 7) == 7
+            assert cli._common._quietly(lambda: warnings.warn("held back") or 7) == 7
 
 
 def test_curvature_view_registers_the_estimate(sphere, monkeypatch, capsys):
@@ -695,9 +697,9 @@ def test_install_hints_work_from_a_checkout(capsys):
     assert install_hint("distributed").startswith('pip install "dask[distributed]"')
     assert missing_optional(ModuleNotFoundError("x", name="triangle")) == "triangle"
     assert missing_optional(ModuleNotFoundError("x", name="igl_hhj.nothing")) is None
-    code, message = cli._failure(ModuleNotFoundError("No module named 'meshio'", name="meshio"))
+    code, message = cli.program._failure(ModuleNotFoundError("No module named 'meshio'", name="meshio"))
     assert code == 2 and 'pip install ".[io]"' in message
-    assert cli._failure(ModuleNotFoundError("No module named 'igl_hhj.x'", name="igl_hhj.x"))[0] == 70
-    root = Path(cli.__file__).resolve().parent
+    assert cli.program._failure(ModuleNotFoundError("No module named 'igl_hhj.x'", name="igl_hhj.x"))[0] == 70
+    root = Path(cli.__file__).resolve().parents[1]          # the igl_hhj package
     stale = [str(p.relative_to(root)) for p in root.rglob("*.py") if "igl-hhj[" in p.read_text()]
     assert stale == []

@@ -2,11 +2,17 @@
 are marked +SKIP (they need EGL and write files)."""
 import doctest
 import importlib
+import pkgutil
 
 import pytest
 
-MODULES = ["igl_hhj.curvature", "igl_hhj.convergence", "igl_hhj.viewer", "igl_hhj.interop", "igl_hhj.mesh_io",
-           "igl_hhj.demos", "igl_hhj.repair", "igl_hhj.features", "igl_hhj.curved.hessian"]
+PACKAGES = ["igl_hhj.viewer", "igl_hhj.mesh_io"]
+"""Packages whose every module's docstrings run (doctest.testmod sees only the objects a
+module defines, not those its package re-exports)."""
+MODULES = ["igl_hhj.curvature", "igl_hhj.convergence", "igl_hhj.interop", "igl_hhj.demos", "igl_hhj.repair",
+           "igl_hhj.features", "igl_hhj.curved.hessian"]
+MODULES += [m for p in PACKAGES
+            for m in [p] + [f"{p}.{i.name}" for i in pkgutil.iter_modules(importlib.import_module(p).__path__)]]
 
 
 @pytest.mark.parametrize("name", MODULES)

@@ -162,21 +162,21 @@ def test_user_script_sees_the_real_types(tmp_path):
     assert revealed["igl_hhj.boundary_treatment(V, F)"] == "str"
     assert revealed["igl_hhj.TriangleMesh(V, F)"] == "igl_hhj.mesh.TriangleMesh"
     assert revealed["bad"] == "list[int]"
-    assert revealed["viewer.register_curvature"].endswith("-> igl_hhj.viewer.Registration")
+    assert revealed["viewer.register_curvature"].endswith("-> igl_hhj.viewer.registration.Registration")
     assert revealed["igl_hhj.viewer.to_image"].endswith("-> NDArray[uint8]")
     # submodule entry points, reached as attributes of igl_hhj (the lazy __getattr__)
     for call in ('igl_hhj.viewer.register_curvature(V, F)', 'igl_hhj.viewer.register_result("bunny_H.ply")'):
-        assert revealed[call] == "igl_hhj.viewer.Registration", (call, revealed[call])
+        assert revealed[call] == "igl_hhj.viewer.registration.Registration", (call, revealed[call])
     assert revealed["igl_hhj.viewer.screenshot"].endswith("-> str")
     assert revealed['igl_hhj.mesh_io.read_mesh("bunny.off")'] == f"tuple[{F64}, NDArray[int64], list[str]]"
     assert revealed['igl_hhj.mesh_io.read_mesh_file("bunny.glb").split'] == "igl_hhj.polygon_io.PolygonSplit"
-    assert revealed['igl_hhj.mesh_io.read_curvature("bunny_H.vtp").estimate'] == "igl_hhj.baselines.CurvatureEstimate"
+    assert revealed['igl_hhj.mesh_io.read_curvature("bunny_H.vtp").estimate'] == "igl_hhj.results.CurvatureEstimate"
     assert "quantity: str =" in revealed["igl_hhj.mesh_io.write_curvature"]
     assert "point_data: typing.Mapping[str, Any] | None =" in revealed["igl_hhj.vtk_files.write_vtk"]
     assert revealed["igl_hhj.polygon_io.split_polygons([0, 1, 2, 3], [0, 4])"] == \
         "tuple[NDArray[int64], NDArray[int64], igl_hhj.polygon_io.PolygonSplit]"
     for call in ('igl_hhj.baselines.estimate("hhj_vertex", V, F)', "igl_hhj.baselines.libigl_quadric(V, F)"):
-        assert revealed[call] == "igl_hhj.baselines.CurvatureEstimate", (call, revealed[call])
+        assert revealed[call] == "igl_hhj.results.CurvatureEstimate", (call, revealed[call])
     assert revealed["igl_hhj.baselines.hhj_vertex(V, F).H"] == F64
     assert revealed["igl_hhj.mesh_report.mesh_report(V, F)"] == "igl_hhj.mesh_report.MeshReport"
     assert revealed["igl_hhj.regge.gauss_curvature(V, F)"] == F64
@@ -186,36 +186,36 @@ def test_user_script_sees_the_real_types(tmp_path):
 
 
 def test_decorated_functions_keep_their_signature():
-    """``kernels.with_large_call_heap`` is ``Callable[P, R] -> Callable[P, R]`` and keeps
+    """``runtime.with_large_call_heap`` is ``Callable[P, R] -> Callable[P, R]`` and keeps
     the run-time signature too (``inspect`` follows ``__wrapped__``); V and F reach the
     heap scope positionally or by keyword."""
     import inspect
 
     import igl_hhj
-    from igl_hhj import kernels
+    from igl_hhj import runtime
     from igl_hhj.surfaces import icosphere
     sig = inspect.signature(igl_hhj.principal_curvature)
     assert list(sig.parameters)[:4] == ["V", "F", "radius", "useKring"]
-    hints = kernels.with_large_call_heap.__annotations__
+    hints = runtime.with_large_call_heap.__annotations__
     assert str(hints["fn"]).startswith("Callable[_P, _R]") and str(hints["return"]).startswith("Callable[_P, _R]")
     seen = []
 
     def probe(V, F=None, *, k=1):
         return V, F, k
-    wrapped = kernels.with_large_call_heap(probe)
-    original = kernels.large_call_heap
+    wrapped = runtime.with_large_call_heap(probe)
+    original = runtime.large_call_heap
 
     def spy(n):
         seen.append(n)
         return original(n)
-    kernels.large_call_heap = spy
+    runtime.large_call_heap = spy
     try:
         V, F = icosphere(1)
         assert wrapped(V, F, k=2) == (V, F, 2)
         assert wrapped(V=V, F=F) == (V, F, 1)
         assert wrapped(V) == (V, None, 1)
     finally:
-        kernels.large_call_heap = original
+        runtime.large_call_heap = original
     assert seen == [len(F), len(F), 0]
 
 

@@ -19,6 +19,7 @@ from igl_hhj.surfaces.meshing import ellipsoid_coarse, icosphere, jitter_tangent
 ps = pytest.importorskip("polyscope")
 
 from igl_hhj import viewer  # noqa: E402
+from igl_hhj.viewer import backend, render  # noqa: E402  (package-private names the tests inspect)
 
 CURV = ("kappa1", "kappa2", "mean H", "Gauss K")
 
@@ -242,7 +243,7 @@ def test_bad_input(mock, ellipsoid, tmp_path):
 
 def test_screenshot_path_not_writable(mock, ellipsoid, tmp_path, monkeypatch):
     # permissions cannot be tested as root (root writes anywhere): fake the access check
-    monkeypatch.setattr(viewer.os, "access", lambda path, mode: False)
+    monkeypatch.setattr(render.os, "access", lambda path, mode: False)
     with pytest.raises(ValueError, match="is not writable"):
         viewer.register_curvature(*ellipsoid, screenshot=tmp_path / "x.png")
 
@@ -267,7 +268,7 @@ def _decode_png(data):
 def test_png_bytes_round_trip():
     rng = np.random.default_rng(1)
     image = rng.integers(0, 256, size=(17, 23, 4), dtype=np.uint8)
-    data = viewer._png_bytes(image)
+    data = render._png_bytes(image)
     assert data[:8] == b"\x89PNG\r\n\x1a\n"
     np.testing.assert_array_equal(_decode_png(data), image)
 
@@ -447,13 +448,13 @@ def test_titles_and_turned_copies(mock, ellipsoid):
     turned = viewer.register_comparison(V, F, name="cmp", view="+x")
     R = viewer.view_rotation("+x")
     np.testing.assert_allclose(turned.rotations["cmp HHJ"], R)
-    box = viewer._REGISTERED["cmp HHJ"]
+    box = backend._REGISTERED["cmp HHJ"]
     np.testing.assert_allclose(box, [(V @ R.T).min(axis=0), (V @ R.T).max(axis=0)])
     # the registration keeps the values as computed (directions in the mesh's own coordinates)
     for key, q in plain.quantities.items():
         np.testing.assert_allclose(turned.quantities[key].values, q.values)
     # colour bars: one per (label, range, colour map) shown
-    assert viewer._colour_bars(plain) == [("mean curvature H [1/length unit]", plain.ranges["H"], "coolwarm")]
+    assert render._colour_bars(plain) == [("mean curvature H [1/length unit]", plain.ranges["H"], "coolwarm")]
 
 
 def test_screenshot_has_a_colour_bar(egl, sphere, tmp_path):
@@ -474,9 +475,9 @@ def test_screenshot_has_a_colour_bar(egl, sphere, tmp_path):
 def test_interactive_layout_leaves_the_panel_free(egl, ellipsoid):
     V, F = ellipsoid
     viewer.register_comparison(V, F, name="win")
-    (cx, cy), wpp = viewer._window_layout(ps, (1200, 700))
-    lo = min(viewer._REGISTERED[n][0, 0] for n in ("win HHJ", "win libigl"))
-    hi = max(viewer._REGISTERED[n][1, 0] for n in ("win HHJ", "win libigl"))
+    (cx, cy), wpp = backend._window_layout(ps, (1200, 700))
+    lo = min(backend._REGISTERED[n][0, 0] for n in ("win HHJ", "win libigl"))
+    hi = max(backend._REGISTERED[n][1, 0] for n in ("win HHJ", "win libigl"))
     left_px, right_px = 600 + (lo - cx) / wpp, 600 + (hi - cx) / wpp
     assert viewer.PANEL_PX <= left_px and right_px <= 1200, (left_px, right_px)
 

@@ -115,7 +115,7 @@ def test_memory_proxy_counts_a_copy_of_the_input(monkeypatch):
     # their 36 B/face
     V, F = _ellipsoid(4)
     views = _solve_kb_per_face(monkeypatch, V, F)
-    monkeypatch.setattr("igl_hhj.curvature.as_mesh", lambda V, F, copy=True: as_mesh(V, F))
+    monkeypatch.setattr("igl_hhj.pipeline.as_mesh", lambda V, F, copy=True: as_mesh(V, F))
     copies = _solve_kb_per_face(monkeypatch, V, F)
     assert copies - views == pytest.approx((V.nbytes + F.nbytes) / 1024 / len(F))
 

@@ -133,3 +133,11 @@ def test_sum_corners_to_vertices():
     np.testing.assert_allclose(w.sum(), m.face_areas.sum())
     vec = m.sum_corners_to_vertices(np.ones((m.n_faces, 3, 2, 2)))
     np.testing.assert_array_equal(vec[:-1, 0, 1], np.bincount(F.ravel()))
+
+
+def test_the_list_of_cached_quantities_is_complete():
+    """TriangleMesh.CACHED (documented in its Notes) names every cached property."""
+    from functools import cached_property
+    cached = {k for k, v in vars(TriangleMesh).items() if isinstance(v, cached_property)}
+    assert set(TriangleMesh.CACHED) == cached and len(TriangleMesh.CACHED) == len(cached)
+    assert all(f"``{k}``" in TriangleMesh.__doc__ for k in cached)

@@ -477,7 +477,7 @@ def _wait_for_library(pid, name, timeout=60):
 @pytest.mark.skipif(not LINUX, reason="POSIX signals, /proc")
 @pytest.mark.parametrize("library", ["_multiarray_umath", "_sparsetools", "pyigl_core"])
 def test_ctrl_c_during_imports_is_one_line(sphere_off, library):
-    """SIGINT while the igl-hhj command is importing numpy (module level of cli.py),
+    """SIGINT while the igl-hhj command is importing numpy (module level of the igl_hhj.cli package),
     scipy.sparse or libigl (inside main): one line, exit 130, no traceback."""
     import shutil
     from pathlib import Path
@@ -576,7 +576,8 @@ def test_biharmonic_extreme_scales_finite_or_solver_error(scale, bc):
 def test_file_guard_reports_the_right_line_across_chunks(tmp_path, monkeypatch):
     """The body scan runs in chunks of _CHUNK bytes: line numbers stay exact."""
     from igl_hhj import mesh_io
-    monkeypatch.setattr(mesh_io, "_CHUNK", 4096)                 # many chunks on a small file
+    from igl_hhj.mesh_io import scan
+    monkeypatch.setattr(scan, "_CHUNK", 4096)                    # many chunks on a small file
     V, F = icosphere(3)
     path = write_off(tmp_path / "s.off", V, F)
     lines = path.read_bytes().split(b"\n")

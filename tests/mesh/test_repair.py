@@ -392,3 +392,15 @@ def test_inconsistent_faces_from_the_compiled_edge_maps_match_the_numpy_form():
         assert np.array_equal(rp._inconsistent_faces(F), want)
         flagged += int(want.any())
     assert flagged > 10                                   # the soups do exercise the test
+
+
+def test_the_repair_warning_points_at_the_callers_line():
+    """The one MeshWarning of a repaired call names the caller's file (not igl_hhj's)."""
+    F = np.vstack([F2, F2[:1]])
+    for fn, args, kw in ((igl_hhj.principal_curvature, (V2, F), {}),
+                         (igl_hhj.shape_operator, (V2, F), {"repair": True}),
+                         (igl_hhj.surface_hessian, (V2, F, V2[:, 0]), {"repair": True})):
+        with warnings.catch_warnings(record=True) as ws:
+            warnings.simplefilter("always")
+            fn(*args, **kw)
+        assert [w.filename for w in ws] == [__file__], fn.__name__

@@ -36,7 +36,7 @@ def _ellipsoid(levels, noise=0.0, seed=6):
 
 
 def _open_saddle(n=90):
-    from igl_hhj.benchmarks.speed import _open_scan
+    from igl_hhj.benchmarks.speed_meshes import _open_scan
     return _open_scan(n)
 
 

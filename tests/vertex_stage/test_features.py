@@ -13,11 +13,12 @@ import scipy.sparse as sp
 from conftest import MESH_DIR
 
 import igl_hhj
+from igl_hhj import creases, intrinsic, recovery
 from igl_hhj import features as ft
-from igl_hhj import intrinsic, recovery
 from igl_hhj.convergence import eoc
 from igl_hhj.mesh import as_mesh
 from igl_hhj.surfaces.creased import CappedCylinder, HalfEllipsoid, capped_cylinder, half_ellipsoid
+from reference_creases import dihedral_magnitudes_reference
 
 FANDISK = MESH_DIR / "fandisk.off"
 
@@ -164,7 +165,7 @@ def test_default_is_the_libigl_contract_bit_for_bit():
     from igl_hhj.surfaces import icosphere
     V, F = icosphere(3)
     mesh = as_mesh(V, F)
-    ref = dropin_vertex_values(mesh, [_shape_operator(mesh, None, None, None, "auto")], 5)
+    ref = dropin_vertex_values(mesh, _shape_operator(mesh, None, None, None, "auto"), 5)
     for out in (igl_hhj.principal_curvature(V, F), igl_hhj.principal_curvature(V, F, feature_angle=None),
                 igl_hhj.principal_curvature(V, F, feature_angle=40)):
         for a, b in zip(out[:4], ref[:4]):
@@ -196,7 +197,7 @@ def test_cube_cut_chains_corners_and_signs():
     assert len(cut.V) == 24                                 # 3 sides per corner
     np.testing.assert_array_equal(cut.parent[:8], np.arange(8))
     np.testing.assert_array_equal(cut.parent[cut.F], F)     # same faces, same corner order
-    _, cut_mesh = ft._cut_mesh(mesh, crease)              # (no unwelded-seam warning)
+    _, cut_mesh = creases.cut_mesh(mesh, crease)              # (no unwelded-seam warning)
     assert cut_mesh.boundary_edges.sum() == 24              # each cube edge twice
     with warnings.catch_warnings():
         warnings.simplefilter("error")                      # the drop-in with features: silent
@@ -374,7 +375,7 @@ def test_cut_mesh_is_the_validated_cut():
     V, F, _ = capped_cylinder(1)
     mesh = as_mesh(V, F)
     mesh.face_normals                                       # cached: passed on to the cut
-    cut, cm = ft._cut_mesh(mesh, ft.crease_edges(mesh))
+    cut, cm = creases.cut_mesh(mesh, ft.crease_edges(mesh))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")                     # the seams coincide: that is the cut
         ref = as_mesh(cut.V, cut.F)
@@ -404,7 +405,7 @@ def test_cut_mesh_costs_one_solve_and_one_validation(monkeypatch):
     from igl_hhj.mesh import TriangleMesh
     from igl_hhj.solvers import HHJSystem
     V, F, mesh = _fandisk()
-    _, cm = ft._cut_mesh(mesh, ft.crease_edges(mesh))
+    _, cm = creases.cut_mesh(mesh, ft.crease_edges(mesh))
     from igl_hhj import kernels
     assert kernels.vertex_components(cm)[1] == 12           # 12 sides ...
     systems = _count_calls(monkeypatch, HHJSystem, "__init__")
@@ -462,7 +463,7 @@ def test_side_tolerance_in_the_units_of_the_part(monkeypatch):
     from igl_hhj.recovery import QUALITY_FLOOR, smoothing_coefficients
     V, F, _ = capped_cylinder(3)
     mesh = as_mesh(V, F)
-    cut, cm = ft._cut_mesh(mesh, ft.crease_edges(mesh))
+    cut, cm = creases.cut_mesh(mesh, ft.crease_edges(mesh))
     labels, n = kernels.vertex_components(cm)
     assert n == 3 and (np.bincount(labels) >= intrinsic.SPLIT_MIN_VERTICES).all()   # caps, side
     N = cm.vertex_normals
@@ -521,8 +522,8 @@ def test_compiled_cut_is_the_reference_cut():
     one ulp of π, with the same crease edges."""
     for name, V, F, named in _random_creased_meshes():
         mesh = as_mesh(V, F)
-        theta = ft._dihedral_magnitudes(mesh)
-        ref = ft.dihedral_magnitudes_reference(mesh)
+        theta = creases.dihedral_magnitudes(mesh)
+        ref = dihedral_magnitudes_reference(mesh)
         assert np.abs(theta - ref).max() <= 4e-16, name
         crease = ft.crease_edges(mesh, 40.0, edges=named, theta=theta)
         np.testing.assert_array_equal(crease, ft.crease_edges(mesh, 40.0, edges=named, theta=ref))

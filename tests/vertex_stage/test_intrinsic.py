@@ -9,7 +9,8 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import igl_hhj
-from igl_hhj import intrinsic, kernels
+import reference_intrinsic as ri
+from igl_hhj import creases, intrinsic, kernels, runtime
 from igl_hhj.benchmarks.vertex_stage import tube_torus
 from igl_hhj import recovery as rc
 from igl_hhj.mesh import TriangleMesh
@@ -49,9 +50,9 @@ def test_compiled_kernels_equal_reference(name):
     N = m.vertex_normals
     w = kernels.recovery_weights(m, rc.QUALITY_FLOOR)
     X, rough = kernels.intrinsic_patch_recovery(m, S, N, w)
-    Xr = intrinsic.recover(m, S, N, w)
+    Xr = ri.recover(m, S, N, w)
     assert rel(X, Xr) <= 1e-12
-    assert rel(rough, intrinsic.roughness(m, S, N, Xr, w)) <= 1e-10
+    assert rel(rough, ri.roughness(m, S, N, Xr, w)) <= 1e-10
     e1, e2 = intrinsic.vertex_frames(N)
     ph = np.stack(intrinsic.transport_phase_components(m, N, e1, e2), axis=1)
     assert np.abs(kernels.transport_phases(m, N) - ph).max() <= 1e-14
@@ -60,10 +61,10 @@ def test_compiled_kernels_equal_reference(name):
                                                        intrinsic.ADAPTIVE_POWER, *intrinsic.ADAPTIVE_RANGE),
                                intrinsic.adaptive_radius(m, pilot, rough, 5), rtol=1e-12)
     Xc, _ = intrinsic.vertex_stage(m, S, 5, rtol=1e-20)      # smoothing to 1e-10
-    Xref, _ = intrinsic.vertex_stage_reference(m, S, 5)
+    Xref, _ = ri.vertex_stage_reference(m, S, 5)
     assert rel(Xc, Xref) <= 1e-7
     PD1, PD2, PV1, PV2 = kernels.principal_hz(Xc, N)
-    R1, R2, Q1, Q2 = intrinsic.principal(Xc, N)
+    R1, R2, Q1, Q2 = ri.principal(Xc, N)
     ref = m.referenced_vertices
     for a, b in ((PD1, R1), (PD2, R2), (PV1, Q1), (PV2, Q2)):
         assert rel(a[ref], b[ref]) <= 1e-12
@@ -89,8 +90,8 @@ def test_transport_is_exact_on_a_cylinder():
     axis = np.array([0.0, 0.0, 1.0])
     tc = np.cross(axis, nu)
     S = tc[:, :, None] * tc[:, None, :]                     # κ = 1 around, 0 along
-    X = intrinsic.recover(m, S, m.vertex_normals, rc.recovery_weights(m))
-    _, _, k1, k2 = intrinsic.principal(X, m.vertex_normals)
+    X = ri.recover(m, S, m.vertex_normals, rc.recovery_weights(m))
+    _, _, k1, k2 = ri.principal(X, m.vertex_normals)
     mid = np.arange(n, 4 * n)
     assert np.abs(k2[mid]).max() < 1e-12 and np.abs(k1[mid] - 1).max() < 1e-12
     # the ambient average + projection loses a part of it
@@ -249,7 +250,7 @@ def test_smoothing_by_parts_is_each_parts_own_smoothing():
 
 
 def test_run_tasks_is_the_serial_loop(monkeypatch):
-    """kernels.run_tasks: the results of the serial loop in item order, whatever the number
+    """runtime.run_tasks: the results of the serial loop in item order, whatever the number
     of workers and the start order (largest first); the first item's exception in item
     order; serial below TASKS_MIN_WORK or with one worker."""
     import threading
@@ -260,26 +261,26 @@ def test_run_tasks_is_the_serial_loop(monkeypatch):
         if x in (3, 5):
             raise KeyError(x)
         return x * x
-    monkeypatch.setattr(kernels, "task_workers", lambda: 2)
-    sizes = [kernels.TASKS_MIN_WORK] * 3
-    assert kernels.run_tasks(fn, [0, 1, 2], sizes) == [0, 1, 4]
+    monkeypatch.setattr(runtime, "task_workers", lambda: 2)
+    sizes = [runtime.TASKS_MIN_WORK] * 3
+    assert runtime.run_tasks(fn, [0, 1, 2], sizes) == [0, 1, 4]
     assert {x for x, _ in seen} == {0, 1, 2}
     seen.clear()
-    assert kernels.run_tasks(fn, [7, 8, 9], [1, 5, kernels.TASKS_MIN_WORK]) == [49, 64, 81]
+    assert runtime.run_tasks(fn, [7, 8, 9], [1, 5, runtime.TASKS_MIN_WORK]) == [49, 64, 81]
     assert seen[0][0] == 9                                  # the largest item starts first
     with pytest.raises(KeyError, match="3"):
-        kernels.run_tasks(fn, [1, 3, 5, 2], [kernels.TASKS_MIN_WORK] * 4)
+        runtime.run_tasks(fn, [1, 3, 5, 2], [runtime.TASKS_MIN_WORK] * 4)
     seen.clear()
-    assert kernels.run_tasks(fn, [1, 2], [1, 1]) == [1, 4]     # too little work: the caller alone
+    assert runtime.run_tasks(fn, [1, 2], [1, 1]) == [1, 4]     # too little work: the caller alone
     assert {t for _, t in seen} == {threading.current_thread().name}
-    monkeypatch.setattr(kernels, "task_workers", lambda: 1)
+    monkeypatch.setattr(runtime, "task_workers", lambda: 1)
     seen.clear()
-    assert kernels.run_tasks(fn, [1, 2], sizes[:2]) == [1, 4]
+    assert runtime.run_tasks(fn, [1, 2], sizes[:2]) == [1, 4]
     assert {t for _, t in seen} == {threading.current_thread().name}
 
 
 def test_smoothing_by_parts_concurrent_is_serial_bit_for_bit(monkeypatch):
-    """The sides of a cut smoothed on two threads at once (kernels.run_tasks) are the serial
+    """The sides of a cut smoothed on two threads at once (runtime.run_tasks) are the serial
     loop's values bit for bit: each call runs single-threaded and a kernel's bits do not
     depend on its thread count."""
     from igl_hhj import features as ft
@@ -287,7 +288,7 @@ def test_smoothing_by_parts_concurrent_is_serial_bit_for_bit(monkeypatch):
     from igl_hhj.surfaces.creased import capped_cylinder
     V, F, _ = capped_cylinder(3)
     mesh = TriangleMesh(V, F)
-    cut, cm = ft._cut_mesh(mesh, ft.crease_edges(mesh))
+    cut, cm = creases.cut_mesh(mesh, ft.crease_edges(mesh))
     N = cm.vertex_normals
     w = kernels.recovery_weights(cm, QUALITY_FLOOR)
     X, rough = kernels.intrinsic_patch_recovery(cm, ft.feature_shape_operator(V, F), N, w)
@@ -302,9 +303,9 @@ def test_smoothing_by_parts_concurrent_is_serial_bit_for_bit(monkeypatch):
         threads.append(threading.current_thread().name)
         return orig(*a, **k)
     monkeypatch.setattr(kernels, "intrinsic_smoothing", spy)
-    monkeypatch.setattr(kernels, "ADAPT_TO_LOAD", False)
+    monkeypatch.setattr(runtime, "ADAPT_TO_LOAD", False)
     for workers in (1, 2):
-        monkeypatch.setattr(kernels, "task_workers", lambda w=workers: w)
+        monkeypatch.setattr(runtime, "task_workers", lambda w=workers: w)
         threads.clear()
         Y = X.copy()
         res = intrinsic.adaptive_smoothing_by_parts(cm, Y, *args, scale_groups=np.zeros(len(cut.V), dtype=int))

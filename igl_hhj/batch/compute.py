@@ -1,0 +1,115 @@
+"""The curvature of one mesh exactly as ``igl-hhj curvature`` and ``igl-hhj batch``
+compute it, and the check of the options they take."""
+from __future__ import annotations
+
+import numpy as np
+
+# (method, per) -> igl_hhj.baselines estimator
+ESTIMATORS = {("hhj", "vertex"): "hhj_vertex", ("hhj", "face"): "hhj_face",
+              ("igl", "vertex"): "libigl_quadric", ("heine", "vertex"): "heine"}
+METHOD_LABELS = {"hhj": "HHJ solve", "igl": "libigl quadric fit", "heine": "Heine P1 solve"}
+MAX_RADIUS = 10**6
+"""Largest ``--radius`` (as :func:`igl_hhj.curvature.check_principal_curvature_args`)."""
+
+
+def check_curvature_options(method, per, radius=None, feature_angle=None):
+    """Raise ``ValueError`` for a combination ``igl-hhj curvature`` / ``batch`` cannot compute.
+
+    ``radius``: hhj per vertex, the smoothing scale of :func:`igl_hhj.principal_curvature`
+    (> 0); hhj per face, ``smoothing`` of :func:`igl_hhj.face_principal_curvature` (≥ 0);
+    igl, libigl's k-ring (> 0); not for heine.  None: the defaults of
+    :func:`default_radius`.  ``feature_angle``: degrees in (0, 180), hhj only (per face
+    only unsmoothed, radius 0), see :mod:`igl_hhj.features`."""
+    if method not in METHOD_LABELS:
+        raise ValueError(f"unknown method {method!r} (use {', '.join(METHOD_LABELS)})")
+    if per not in ("vertex", "face"):
+        raise ValueError(f"unknown per {per!r} (use vertex or face)")
+    if method != "hhj" and per == "face":
+        raise ValueError(f"--method {method} computes per-vertex curvature only; "
+                         f"use --per vertex (or --method hhj for per-face values)")
+    if radius is not None:
+        if method == "heine":
+            raise ValueError("--radius applies to --method hhj and igl, not heine")
+        if isinstance(radius, (bool, np.bool_)) or not isinstance(radius, (int, np.integer)):
+            raise ValueError(f"--radius must be an integer, got {radius!r}")
+        if radius < 0 or (radius == 0 and not (method == "hhj" and per == "face")):
+            raise ValueError(f"--radius must be a positive integer (0 only with --per face), "
+                             f"got {radius}")
+        if radius > MAX_RADIUS:
+            raise ValueError(f"--radius must be at most {MAX_RADIUS} (10**6), got {radius:.3g}")
+    if feature_angle is not None:
+        if method != "hhj":
+            raise ValueError(f"--feature-angle applies to --method hhj, not {method}")
+        if per == "face" and radius:
+            raise ValueError("--feature-angle with --per face gives Walker's S_h of the cut surface "
+                             "unsmoothed: use --radius 0 (or --per vertex)")
+        from ..features import check_feature_angle
+        try:
+            check_feature_angle(feature_angle)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"--{exc}".replace("feature_angle", "feature-angle", 1)) from None
+
+
+def default_radius(method, per):
+    """The ``radius`` used when none is given: 5 per vertex (as ``igl.principal_curvature``),
+    0 per face (Walker's S_h itself), None for heine."""
+    if method == "heine":
+        return None
+    return 0 if per == "face" else 5
+
+
+def _call(label, fn, *args, **kwargs):
+    return fn(*args, **kwargs)
+
+
+def compute_curvature(V, F, *, method="hhj", per="vertex", radius=None, keep_shape_operator=False,
+                      run=None, feature_angle=None):
+    """Curvature of one mesh exactly as ``igl-hhj curvature`` and ``igl-hhj batch`` compute it.
+
+    Parameters
+    ----------
+    V : (#V, 3) float64, F : (#F, 3) int
+        A mesh :class:`igl_hhj.mesh.TriangleMesh` accepts.
+    method : {"hhj", "igl", "heine"}
+    per : {"vertex", "face"} ("face": hhj only)
+    radius : int, optional
+        See :func:`check_curvature_options`; None: :func:`default_radius`.
+    keep_shape_operator : bool
+        Also return the HHJ shape operator S_h (Walker eq. 5.12), as stored in
+        the ``.npz`` output; ignored for igl/heine.
+    run : callable, optional
+        ``run(label, fn, *args, **kwargs)`` wraps each stage (the CLI's
+        progress lines); default: call ``fn``.
+    feature_angle : float, optional
+        hhj only: sharp features (:mod:`igl_hhj.features`), creases above this many degrees.
+
+    Returns
+    -------
+    est : igl_hhj.baselines.CurvatureEstimate
+    S : (#F, 3, 3) float64 or None
+    """
+    from .. import baselines
+    check_curvature_options(method, per, radius, feature_angle)
+    run = run or _call
+    if radius is None:
+        radius = default_radius(method, per)
+    label = f"{METHOD_LABELS[method]} ({per})"
+    if method == "hhj" and feature_angle is not None:
+        from ..curvature import shape_operator
+        hhj = baselines.hhj_face if per == "face" else baselines.hhj_vertex
+        S = run(f"{METHOD_LABELS[method]} (shape operator, creases)", shape_operator, V, F,
+                feature_angle=feature_angle) if keep_shape_operator or per == "face" else None
+        if per == "face":                 # S_h of the cut surface itself
+            return run(f"curvatures ({per})", hhj, V, F, shape_operator=S), S
+        return run(label, hhj, V, F, radius=radius, feature_angle=feature_angle), S
+    if method == "hhj":
+        hhj = baselines.hhj_face if per == "face" else baselines.hhj_vertex
+        scale = {"smoothing": radius} if per == "face" else {"radius": radius}
+        if keep_shape_operator:    # solve once, keep S_h for the npz, derive the curvatures from it
+            from ..curvature import shape_operator
+            S = run(f"{METHOD_LABELS[method]} (shape operator)", shape_operator, V, F)
+            return run(f"curvatures ({per})", hhj, V, F, shape_operator=S, **scale), S
+        return run(label, hhj, V, F, **scale), None
+    if method == "igl":
+        return run(label, baselines.libigl_quadric, V, F, radius=radius), None
+    return run(label, baselines.estimate, ESTIMATORS[method, per], V, F), None
