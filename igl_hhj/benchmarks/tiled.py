@@ -4,21 +4,20 @@
 per mesh the faces, tiles, overlap (rings), the tiled run's wall time on an embedded
 cluster of 2 single-threaded workers and the whole-mesh call's (2 threads), faces
 computed / faces in the mesh, peak resident memory, and the largest difference to the
-whole-mesh values relative to max |κ|, at ``rtol=1e-12`` (the cut's effect, which the
+whole-mesh values relative to max |κ| (absolute on a flat mesh, max |κ| = 0), at ``rtol=1e-12`` (the cut's effect, which the
 overlap rule bounds by 1e-6) and at the default ``rtol`` (the solvers' tolerance).
 
 Options
 -------
-``--decay``       the cut's effect against the ring distance, on half-space cuts of
-                  generated and real meshes, computed with direct solves everywhere
-                  (``exact_dropin``): the HHJ decay rate and the ring from which the
-                  change stays below 1e-6, beside the rule (:mod:`igl_hhj.tiled.reach`).
 ``--big N``       a jittered torus of ≥ N faces written to binary PLY block by block,
                   then ``curvature_file`` on it in a child process under
                   ``prlimit --as`` (``--cap``, default 4 GB, each process), niced.
 ``--scale N``     tiled (2 workers) against whole-mesh wall time per face on a jittered
                   torus of about N faces.
 ``--meshes DIR``  the libigl tutorial meshes (default ``/work/tutdata`` when present).
+
+The cut's effect against the ring distance (half-space cuts, direct solves) is
+``python -m igl_hhj.benchmarks.tiled_decay``.
 """
 from __future__ import annotations
 
@@ -106,9 +105,10 @@ def _default_mesh_dir():
 
 # --------------------------------------------------------------------------- measuring
 def _relative_difference(T, W):
+    """max |ΔPV1|, |ΔPV2| over the vertices / max |κ| (1 on a flat mesh: the absolute difference)."""
     kmax = np.nanmax(np.abs(np.r_[W[2], W[3]]))
     with np.errstate(invalid="ignore"):
-        return float(max(np.nanmax(np.abs(T[2] - W[2])), np.nanmax(np.abs(T[3] - W[3]))) / kmax)
+        return float(max(np.nanmax(np.abs(T[2] - W[2])), np.nanmax(np.abs(T[3] - W[3]))) / (kmax or 1.0))
 
 
 def _peak_children():
