@@ -224,9 +224,9 @@ def principal_curvature(V: Any, F: Any = None, radius: float = 5, useKring: bool
         plan = plan_tiles(ArraySource(V, F), tmp / "plan", tile_faces)
         local = client is None and scheduler is None and (workers == 0 or plan.n_tiles == 1)
         if local:
-            store = ArrayStore(len(V))
-            stats, computed = run_tiles(ArraySource(V, F), plan, store, params, progress=progress)
-            PD1, PD2, PV1, PV2 = (store.arrays[k] for k in ("PD1", "PD2", "PV1", "PV2"))
+            arrays = ArrayStore(len(V))
+            stats, computed = run_tiles(ArraySource(V, F), plan, arrays, params, progress=progress)
+            PD1, PD2, PV1, PV2 = (arrays.arrays[k] for k in ("PD1", "PD2", "PV1", "PV2"))
         else:
             np.save(tmp / "V.npy", V)
             np.save(tmp / "F.npy", F)
