@@ -2,6 +2,7 @@
 view or screenshot."""
 from __future__ import annotations
 
+import argparse
 import os
 import time
 from pathlib import Path
@@ -21,6 +22,9 @@ def _curvature(args):
     from ..mesh import TriangleMesh
 
     say = _say(args)
+    if args.tile_faces is not None:            # out of core, tile by tile (igl_hhj.tiled)
+        from ..tiled.command import run
+        return run(args, say)
 
     per = args.per
     try:
@@ -207,4 +211,14 @@ def add_parser(sub):
     c.add_argument("-q", "--quiet", action="store_true",
                    help=f"print nothing but warnings and errors: no summary on stdout, no progress "
                         f"lines (stderr, meshes > {LARGE_MESH_FACES} faces)")
+    c.add_argument("--tile-faces", type=int, default=None, metavar="N",
+                   help="meshes larger than memory: compute in tiles of about N faces (grown by "
+                        "the overlap the computation needs) on Dask; -o OUT is then a folder of "
+                        ".npy arrays (igl_hhj/docs/tiled.md)")
+    c.add_argument("--scheduler", metavar="ADDRESS",
+                   help="with --tile-faces: a Dask scheduler (default: embedded cluster)")
+    c.add_argument("--workers", type=int, metavar="N",
+                   help="with --tile-faces: worker processes of the embedded cluster (default: cores; 0: in-process)")
+    c.add_argument("--resume", action=argparse.BooleanOptionalAction, default=True,
+                   help="with --tile-faces: continue an interrupted run into OUT (default on)")
     c.set_defaults(func=_curvature)

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import csv
 import os
-import shutil
 import signal
 import subprocess
 import sys
@@ -17,7 +16,7 @@ from pathlib import Path
 import igl
 import numpy as np
 import pytest
-from conftest import require_test_extra
+from conftest import _kill, _wait_for, require_test_extra
 
 from igl_hhj import baselines, batch, cli
 
@@ -281,14 +280,6 @@ def _batch_cmd(*args):
     return [sys.executable, "-m", "igl_hhj.cli", "batch", *map(str, args)]
 
 
-def _wait_for(pred, timeout, what):
-    t = time.monotonic()
-    while not pred():
-        if time.monotonic() - t > timeout:
-            raise AssertionError(f"timed out after {timeout} s waiting for {what}")
-        time.sleep(0.05)
-
-
 @pytest.mark.slow
 def test_resume_after_sigint(tmp_path):
     folder = tmp_path / "in"
@@ -332,59 +323,7 @@ def test_resume_after_sigint(tmp_path):
 
 
 # --------------------------------------------------------------------------- loopback cluster
-def _spawn(args, log, env=None):
-    return subprocess.Popen(args, stdout=log, stderr=subprocess.STDOUT, start_new_session=True,
-                            env=env)
-
-
-def _kill(proc):
-    if proc.poll() is None:
-        try:
-            os.killpg(proc.pid, signal.SIGKILL)
-        except ProcessLookupError:
-            pass
-    proc.wait(timeout=30)
-
-
-@pytest.fixture(scope="module")
-def loopback_cluster(tmp_path_factory):
-    """``dask scheduler`` and two ``dask worker`` processes on 127.0.0.1 (killed in teardown)."""
-    dask_cli = shutil.which("dask", path=os.path.dirname(sys.executable)) or shutil.which("dask")
-    if dask_cli is None:
-        pytest.fail("the 'dask' command of dask[distributed] is not installed")
-    d = tmp_path_factory.mktemp("cluster")
-    sched_file = d / "scheduler.json"
-    log = open(d / "cluster.log", "w")
-    procs = []
-    try:
-        procs.append(_spawn([dask_cli, "scheduler", "--host", "127.0.0.1", "--port", "0",
-                             "--no-dashboard", "--scheduler-file", str(sched_file)], log))
-        _wait_for(sched_file.exists, 60, "the scheduler")
-        time.sleep(0.2)
-        import json
-        address = json.loads(sched_file.read_text())["address"]
-        assert address.startswith("tcp://127.0.0.1:")
-        # the worker configuration igl_hhj/docs/batch.md ("Starting a cluster") recommends
-        (d / "dask").mkdir()
-        (d / "dask" / "igl-hhj.yaml").write_text(
-            "distributed:\n  nanny:\n    pre-spawn-environ:\n      MALLOC_TRIM_THRESHOLD_: null\n")
-        env = {**os.environ, "DASK_CONFIG": str(d / "dask")}
-        workers = [_spawn([dask_cli, "worker", address, "--host", "127.0.0.1", "--nthreads", "1",
-                           "--nworkers", "1", "--no-dashboard", "--name", f"w{i}"], log, env)
-                   for i in range(2)]
-        procs += workers
-        from distributed import Client
-        with Client(address, timeout="30s") as client:
-            client.wait_for_workers(2, timeout=90)
-            trim = client.run(lambda: os.environ.get("MALLOC_TRIM_THRESHOLD_"))
-            assert list(trim.values()) == [None, None], trim
-        yield address, workers
-    finally:
-        for p in reversed(procs):
-            _kill(p)
-        log.close()
-
-
+# (the loopback_cluster fixture is in tests/conftest.py)
 @pytest.mark.slow
 def test_loopback_cluster(loopback_cluster, collection, tmp_path):
     address, _ = loopback_cluster

@@ -68,6 +68,7 @@ MODULE_LAYER = {
     "igl_hhj.mesh_report": "io",
     "igl_hhj.viewer": "app",
     "igl_hhj.batch": "app",
+    "igl_hhj.tiled": "app",            # one mesh larger than memory, in tiles on Dask
     "igl_hhj.cli": "app",
     "igl_hhj.demos": "app",
     "igl_hhj.benchmarks": "app",
