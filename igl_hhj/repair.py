@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from .mesh import MeshWarning, validate_faces, validate_vertices, zero_area_faces
+from .mesh import MeshWarning, check_mesh_size, validate_faces, validate_vertices, zero_area_faces
 from .mesh_objects import mesh_arrays
 
 __all__ = ["RepairedMesh", "repair_mesh", "vertex_values_to_caller", "face_values_to_caller",
@@ -193,6 +193,8 @@ def repair_mesh(V: Any, F: Any) -> RepairedMesh:
     repeated = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
     dbl, X = _double_areas(V, F)
     ev = np.stack([X[:, 2] - X[:, 1], X[:, 0] - X[:, 2], X[:, 1] - X[:, 0]], axis=1)
+    with np.errstate(over="ignore", invalid="ignore"):
+        check_mesh_size((ev ** 2).sum(axis=2).max(axis=1))      # "too small", not every face dropped
     degenerate = zero_area_faces(ev, dbl) & ~repeated
     keep = ~(repeated | degenerate)
     summary["repeated corner"] = int(repeated.sum())
