@@ -14,7 +14,7 @@ import numpy as np
 
 from ..errors import MeshFileError
 from ..results import QUANTITIES
-from .compute import compute_curvature
+from .compute import MeshRefusedError, compute_curvature, compute_curvature_repairing
 
 
 PERCENTILES = (1, 50, 99)
@@ -99,6 +99,7 @@ class Options:
     timeout: float | None = None
     memory_limit: int | None = None
     feature_angle: float | None = None
+    strict: bool = False
 
     @property
     def sandboxed(self):
@@ -135,22 +136,21 @@ def process_mesh(job, options, measure_peak=True):
 
 def _compute_one(job, options, extra):
     """(status, error message, reader messages) of one mesh; statistics go into ``extra``."""
-    from ..mesh import TriangleMesh
     from ..mesh_io import read_mesh
     said = []
     try:
         V, F, said = read_mesh(job.path)
         said = list(said)
         extra.update(vertices=len(V), faces=len(F))
-        try:
-            mesh = TriangleMesh(V, F)
-        except (ValueError, TypeError) as exc:
-            raise MeshFileError(f"{job.path}: igl_hhj cannot use this mesh: {exc}") from None
-        est, S = compute_curvature(mesh.V, mesh.F, method=options.method, per=options.per,
-                                   radius=options.radius,
-                                   keep_shape_operator=options.fmt == "npz",
-                                   feature_angle=options.feature_angle)
-        _atomic_write(job.output, options.fmt, mesh.V, mesh.F, est, options.method, S)
+        try:          # what the drop-in repairs is repaired (one warning), unless strict
+            est, S, _, _ = compute_curvature_repairing(V, F, strict=options.strict, method=options.method,
+                                                       per=options.per, radius=options.radius,
+                                                       keep_shape_operator=options.fmt == "npz",
+                                                       feature_angle=options.feature_angle)
+        except MeshRefusedError as exc:
+            raise MeshFileError(f"{job.path}: igl_hhj cannot use this mesh: {exc}"
+                                + (" (--strict)" if exc.defect else "")) from None
+        _atomic_write(job.output, options.fmt, V, F, est, options.method, S)
         extra.update(_percentile_stats(est))
         status, message = "ok", None
     except MemoryError:

@@ -150,7 +150,8 @@ def _import_distributed():
 
 def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per="vertex",
               radius=None, fmt="npz", resume=True, timeout=None, memory_limit=None, retries=2,
-              group_bytes=GROUP_BYTES, progress=True, stream=None, client=None, feature_angle=None):
+              group_bytes=GROUP_BYTES, progress=True, stream=None, client=None, feature_angle=None,
+              strict=False):
     """Curvature of every mesh in ``inputs``; one output per mesh and a summary.
 
     Parameters
@@ -167,6 +168,10 @@ def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per
         per task); 0: run in this process.  Ignored with ``scheduler``.
     method, per, radius, feature_angle
         As ``igl-hhj curvature`` (:func:`compute_curvature`).
+    strict : bool
+        Refuse (an error row) a mesh that :func:`igl_hhj.principal_curvature` would repair;
+        default: repair it the same way, the repair named in the row's warnings
+        (:func:`igl_hhj.batch.compute.compute_curvature_repairing`).
     fmt : {"npz", "ply", "vtp", "vtu"}
     resume : bool
         Skip inputs whose output is newer than the input (status ``skipped``).
@@ -206,7 +211,7 @@ def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per
     if not jobs:
         raise ValueError("no input meshes")
     options = Options(method, per, None if radius is None else int(radius), fmt, timeout, memory_limit,
-                      None if feature_angle is None else float(feature_angle))
+                      None if feature_angle is None else float(feature_angle), bool(strict))
     previous = _previous_rows(outdir / "summary.csv")
     key = options_key(method, per, radius, feature_angle)
     made = _read_options_file(outdir)

@@ -37,7 +37,7 @@ def rotation(rng):
 
 def write_collection(folder, n=20, levels=(1, 2, 3), seed=0):
     """``n`` ellipsoids (icosphere subdivisions ``levels``, random axes, rigid motion) as
-    .off/.obj/.ply in ``folder`` and ``folder/sub``, plus corrupt, empty and non-manifold files.
+    .off/.obj/.ply in ``folder`` and ``folder/sub``, plus corrupt, empty and too small files.
 
     Returns (good paths, {bad path: expected message fragment}).
     """
@@ -61,10 +61,10 @@ def write_collection(folder, n=20, levels=(1, 2, 3), seed=0):
         (folder / name).write_text(text)
         bad[folder / name] = {"corrupt.off": "truncated or corrupt", "garbage.ply": "not a PLY file",
                               "empty.obj": "file is empty"}[name]
-    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1.0]])
-    F = np.array([[0, 1, 2], [1, 0, 3], [0, 1, 4]])
-    igl.write_triangle_mesh(str(folder / "nonmanifold.off"), V, F)
-    bad[folder / "nonmanifold.off"] = "non-manifold"
+    V, F = spheres[1]                  # too small for float64 (the drop-in's repair would not help)
+    lines = ["OFF", f"{len(V)} {len(F)} 0"] + [" ".join(repr(float(x) * 1e-85) for x in v) for v in V]
+    (folder / "tiny.off").write_text("\n".join(lines + ["3 " + " ".join(map(str, f)) for f in F]) + "\n")
+    bad[folder / "tiny.off"] = "too small"
     (folder / "notes.txt").write_text("not a mesh: ignored in a folder\n")
     return good, bad
 
