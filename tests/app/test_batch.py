@@ -207,7 +207,7 @@ def test_user_errors(collection, tmp_path, capsys, monkeypatch):
                      "-o", str(out), "-q"]) == 1
     rows = read_summary(out)
     assert rows[str(tmp_path / "missing.off")]["error"].endswith("no such file")
-    assert {r["status"] for p, r in rows.items() if p.endswith(".off") and "sub" in p} == {"ok"}
+    assert {r["status"] for p, r in rows.items() if p.endswith(".off") and "sub" in p} == {"ok"}, rows
 
 
 @pytest.mark.slow
