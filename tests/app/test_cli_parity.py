@@ -158,3 +158,21 @@ def test_repair_flags_only_patches_without_a_one_sided_face():
     assert R.summary["two-sided"] == len(F) and R.two_sided.sum() == len(F)
     assert (R.face_map[R.two_sided] < len(F)).all()
     assert not repair.two_sided_vertices(R)[R.F[~R.two_sided].ravel()].any()
+
+
+# --------------------------------------------------------------------------- small things
+def test_closed_stdout_pipe_is_quiet(tmp_path):
+    """``igl-hhj info m.off | head``: the reader is gone; no 'error: Broken pipe', exit 141."""
+    import os
+    import subprocess
+    import sys
+    V, F = icosphere(1)
+    path = write_off(tmp_path / "s.off", V, F)
+    r, w = os.pipe()
+    os.close(r)                                     # every write to w fails with EPIPE
+    try:
+        run = subprocess.run([sys.executable, "-m", "igl_hhj.cli", "info", str(path)], stdout=w,
+                             stderr=subprocess.PIPE, text=True, timeout=120)
+    finally:
+        os.close(w)
+    assert run.returncode == cli.program.EXIT_BROKEN_PIPE == 141 and run.stderr == "", run.stderr
