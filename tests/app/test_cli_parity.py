@@ -176,3 +176,18 @@ def test_closed_stdout_pipe_is_quiet(tmp_path):
     finally:
         os.close(w)
     assert run.returncode == cli.program.EXIT_BROKEN_PIPE == 141 and run.stderr == "", run.stderr
+
+
+@pytest.mark.parametrize("content, why", [("{\"a\":" * 100000 + "1" + "}" * 100000, "nested too deeply"),
+                                          ("[1, 2]", "a JSON list"), ("{oops", "not JSON")])
+def test_batch_bad_options_file_is_a_usage_error(tmp_path, capsys, content, why):
+    """A deeply nested options file stopped batch with exit 4 'computation failed'."""
+    from igl_hhj import batch
+    V, F = icosphere(1)
+    path = write_off(tmp_path / "s.off", V, F)
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / batch.OPTIONS_FILE).write_text(content)
+    assert cli.main(["batch", str(path), "-o", str(out), "--workers", "0", "-q"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and batch.OPTIONS_FILE in err[0] and why in err[0] and "delete it" in err[0]
