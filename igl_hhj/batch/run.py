@@ -148,6 +148,14 @@ def _import_distributed():
                           f"{install_hint('distributed')} (or --workers 0: in-process)") from None
 
 
+def _written_since(path, t_ns):
+    """Whether ``path`` exists and was written after ``t_ns`` (``time.time_ns()``)."""
+    try:
+        return os.stat(path).st_mtime_ns > t_ns
+    except OSError:
+        return False
+
+
 def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per="vertex",
               radius=None, fmt="npz", resume=True, timeout=None, memory_limit=None, retries=2,
               group_bytes=GROUP_BYTES, progress=True, stream=None, client=None, feature_angle=None,
@@ -292,6 +300,13 @@ def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per
         if box is not None:
             box.close()
         sweep_temporaries(outdir)
+        if interrupted:          # outputs the workers finished after the interrupt reached us
+            for job in todo:
+                if job.path not in rows and _written_since(job.output, now):
+                    row = _skipped_row(job, {})            # its statistics re-read from the .npz
+                    row.update(status="ok", warnings="finished by a worker after Ctrl-C (no timings)")
+                    rows[job.path] = row                   # into the summary (the bar is closed)
+                    made[rel[job.path]]["done"] = True
         if todo:
             _write_options_file(outdir, made)
         done = [rows[j.path] for j in jobs if j.path in rows]
