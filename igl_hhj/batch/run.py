@@ -62,8 +62,19 @@ def _in_process(groups, options, on_row):
             on_row(run_group([job], options)[0])
 
 
+NO_WORKER_SECONDS = 120.0
+"""How long the tasks may wait with no worker in the cluster before their meshes become error
+rows.  A worker whose event loop stops answering (a parser stuck in C code holding the GIL) is
+dropped by the scheduler after ``distributed.scheduler.worker-ttl`` (300 s); its nanny then shuts
+down for good instead of restarting it (dask/distributed#8537), and with ``--workers 1`` nothing
+is left to run the remaining tasks: ``as_completed`` waited forever (the hangs of 110 s and
+300 s and more)."""
+WATCH_SECONDS = 5.0
+"""How often the client checks that the cluster still has workers while no task finishes."""
+
+
 def _on_dask(client, groups, options, on_row, retry_singles=True):
-    from distributed import as_completed
+    from distributed import wait
     futures = {}
 
     def submit(group, attempt):
@@ -73,24 +84,46 @@ def _on_dask(client, groups, options, on_row, retry_singles=True):
         futures[fut] = (group, attempt)
         return fut
 
-    ac = as_completed([submit(g, 0) for g in groups])
+    def finished(fut):
+        group, attempt = futures.pop(fut)
+        try:
+            rows = fut.result()
+        except Exception as exc:             # the task failed without producing rows
+            if len(group) > 1 and retry_singles:
+                for job in group:              # isolate the mesh that kills its worker
+                    submit([job], attempt + 1)
+                return
+            what = ("the worker process computing it died every time it was tried (a crash "
+                    "or out of memory; Dask's distributed.scheduler.allowed-failures retries)"
+                    if type(exc).__name__ == "KilledWorker" else
+                    f"{type(exc).__name__}: {' '.join(str(exc).split())}")
+            rows = [_row(job, "error", error=f"{job.path}: {what}") for job in group]
+        for row in rows:
+            on_row(row)
+
+    for g in groups:
+        submit(g, 0)
+    no_worker_since = None
     try:
-        for fut in ac:
-            group, attempt = futures.pop(fut)
+        while futures:
             try:
-                rows = fut.result()
-            except Exception as exc:             # the task failed without producing rows
-                if len(group) > 1 and retry_singles:
-                    for job in group:              # isolate the mesh that kills its worker
-                        ac.add(submit([job], attempt + 1))
-                    continue
-                what = ("the worker process computing it died every time it was tried (a crash "
-                        "or out of memory; Dask's distributed.scheduler.allowed-failures retries)"
-                        if type(exc).__name__ == "KilledWorker" else
-                        f"{type(exc).__name__}: {' '.join(str(exc).split())}")
-                rows = [_row(job, "error", error=f"{job.path}: {what}") for job in group]
-            for row in rows:
-                on_row(row)
+                done, _ = wait(list(futures), timeout=WATCH_SECONDS, return_when="FIRST_COMPLETED")
+            except TimeoutError:
+                done = ()
+            for fut in done:
+                finished(fut)
+            if done or client.scheduler_info().get("workers"):
+                no_worker_since = None
+                continue
+            no_worker_since = no_worker_since or time.monotonic()
+            if time.monotonic() - no_worker_since > NO_WORKER_SECONDS:
+                client.cancel(list(futures))
+                for group, _ in list(futures.values()):
+                    for job in group:
+                        on_row(_row(job, "error", error=f"{job.path}: no worker process left to compute "
+                                                        f"it for {NO_WORKER_SECONDS:g} s (they died or "
+                                                        f"stopped answering; rerun to retry)"))
+                futures.clear()
     finally:
         if futures:
             client.cancel(list(futures))

@@ -191,3 +191,30 @@ def test_batch_bad_options_file_is_a_usage_error(tmp_path, capsys, content, why)
     assert cli.main(["batch", str(path), "-o", str(out), "--workers", "0", "-q"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and batch.OPTIONS_FILE in err[0] and why in err[0] and "delete it" in err[0]
+
+
+def test_batch_does_not_wait_forever_without_workers(tmp_path, monkeypatch):
+    """The embedded cluster lost its last worker (its nanny gives up on a worker that stopped
+    answering, dask/distributed#8537): the tasks become error rows after NO_WORKER_SECONDS
+    instead of the client waiting forever (batch --workers 1 hung 110 s, 300 s)."""
+    distributed = pytest.importorskip("distributed")
+    import time
+
+    from igl_hhj.batch import jobs, run
+    monkeypatch.setattr(run, "NO_WORKER_SECONDS", 1.0)
+    monkeypatch.setattr(run, "WATCH_SECONDS", 0.2)
+    V, F = icosphere(1)
+    path = write_off(tmp_path / "s.off", V, F)
+    job = jobs.Job(str(path), str(tmp_path / "s.npz"))
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                  dashboard_address="127.0.0.1:0") as cluster, \
+            distributed.Client(cluster) as client:
+        cluster.scale(0)
+        t = time.monotonic()
+        while client.scheduler_info()["workers"] and time.monotonic() - t < 30:
+            time.sleep(0.05)
+        rows = []
+        t = time.monotonic()
+        run._on_dask(client, [[job]], jobs.Options(), rows.append)
+        assert time.monotonic() - t < 20
+    assert len(rows) == 1 and rows[0]["status"] == "error" and "no worker process left" in rows[0]["error"]
