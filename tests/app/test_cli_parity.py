@@ -218,3 +218,22 @@ def test_batch_does_not_wait_forever_without_workers(tmp_path, monkeypatch):
         run._on_dask(client, [[job]], jobs.Options(), rows.append)
         assert time.monotonic() - t < 20
     assert len(rows) == 1 and rows[0]["status"] == "error" and "no worker process left" in rows[0]["error"]
+
+
+def test_quad_split_is_a_note_everywhere(tmp_path, capsys):
+    """A quad split is a plain line of curvature / info and its own summary column in batch,
+    never an 'igl-hhj: warning:' line (batch printed it as a warning)."""
+    pytest.importorskip("distributed")
+    path = tmp_path / "q.obj"                                       # a cube of 6 quads
+    V = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float)
+    Q = np.array([[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]])
+    lines = [f"v {x:g} {y:g} {z:g}" for x, y, z in V] + ["f " + " ".join(str(i + 1) for i in q) for q in Q]
+    path.write_text("\n".join(lines) + "\n")
+    assert cli.main(["curvature", str(path)]) == 0
+    cap = capsys.readouterr()
+    assert "6 quads split into 12 triangles" in cap.out and "warning" not in cap.err
+    out = tmp_path / "out"
+    assert cli.main(["batch", str(path), "-o", str(out), "--workers", "0", "-q"]) == 0
+    assert "warning" not in capsys.readouterr().err
+    row = next(csv.DictReader(open(out / "summary.csv")))
+    assert row["warnings"] == "" and row["polygons"].startswith("6 quads split into 12 triangles")
