@@ -117,7 +117,7 @@ def test_register_comparison_shares_ranges(mock, ellipsoid):
     reg = viewer.register_comparison(V, F, name="cmp", enabled="K")
     assert set(reg.structures) == {"cmp HHJ", "cmp libigl"}
     for q, lab in zip(viewer.QUANTITIES, CURV):
-        a = reg.quantities[("cmp HHJ", f"{lab} (HHJ faces)")]
+        a = reg.quantities[("cmp HHJ", f"{lab} (HHJ vertices)")]     # like with like: the default
         b = reg.quantities[("cmp libigl", f"{lab} (libigl vertices)")]
         assert a.vminmax == b.vminmax == reg.ranges[q]
         assert reg.ranges[q] == viewer.color_range(a.values, b.values, robust=1.0)   # the default
@@ -403,7 +403,7 @@ def test_registration_repr_is_short(mock, ellipsoid):
     reg = viewer.register_comparison(*ellipsoid, name="r")
     text = repr(reg)
     assert len(text) < 400 and "array" not in text
-    assert "'r HHJ'" in text and "mean H (HHJ faces)" in text
+    assert "'r HHJ'" in text and "mean H (HHJ vertices)" in text
 
 
 # --------------------------------------------------------------------------- views, titles, colour bars (issue 14)
@@ -440,7 +440,7 @@ def test_best_view_is_the_largest_projected_area(ellipsoid):
 def test_titles_and_turned_copies(mock, ellipsoid):
     V, F = ellipsoid
     plain = viewer.register_comparison(V, F, name="cmp")
-    assert plain.titles == {"cmp HHJ": f"HHJ, per face — cmp, {len(F):,} faces",
+    assert plain.titles == {"cmp HHJ": f"HHJ, per vertex — cmp, {len(F):,} faces",
                             "cmp libigl": f"libigl quadric fit, per vertex — cmp, {len(F):,} faces"}
     assert viewer.register_curvature(V, F, name="c", title="").titles == {}
     turned = viewer.register_comparison(V, F, name="cmp", view="+x")
