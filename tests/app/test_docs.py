@@ -222,3 +222,16 @@ def test_inline_calls_run_as_written():
 def _has(module):
     import importlib.util
     return importlib.util.find_spec(module) is not None
+
+
+@pytest.mark.slow
+def test_api_page_shows_one_signature_and_code_wraps(html):
+    """curvature_of opened the API page with its overload signatures (4, then 2): one now;
+    the code blocks wrap long lines instead of running off the right edge (tutorial)."""
+    api = (html / "api.html").read_text()
+    assert api.count('id="igl_hhj.curvature_of"') == 1
+    block = api.split('id="igl_hhj.curvature_of"', 1)[1].split("</dt>", 1)[1].split("<dd>", 1)[0]
+    assert 'class="sig' not in block, "a second signature follows the first"
+    tutorial = (html / "tutorial.html").read_text()
+    assert "custom.css" in tutorial
+    assert "white-space: pre-wrap" in (html / "_static" / "custom.css").read_text()
