@@ -84,12 +84,19 @@ def dihedral_magnitudes(mesh):
 def _edge_index(mesh, pairs, name):
     """Unique-edge indices of the vertex ``pairs`` (k, 2); ValueError names a pair that is no edge."""
     P = _as_array(pairs, name)
+    if P.size == 0 and P.ndim == 1:             # [] is no pair, as np.zeros((0, 2))
+        P = P.reshape(0, 2)
     if P.ndim != 2 or P.shape[1] != 2:
         raise ValueError(f"{name} must be a (k, 2) array of vertex pairs, got shape {P.shape}")
     if P.size and not np.issubdtype(P.dtype, np.integer):
         raise TypeError(f"{name} must hold integer vertex indices, got dtype {P.dtype}")
-    P = np.sort(P.astype(np.int64), axis=1)
     nV = mesh.n_vertices
+    out = (P < 0) | (P >= nV)                   # on the caller's dtype: uint64 is not wrapped to int64
+    if out.any():
+        j = int(np.flatnonzero(out.any(axis=1))[0])
+        raise ValueError(f"{name} row {j} ({int(P[j, 0])}, {int(P[j, 1])}) is not an edge of the mesh "
+                         f"(vertex index out of range, #V = {nV})")
+    P = np.sort(P.astype(np.int64), axis=1)
     E = mesh.edges.astype(np.int64)                            # int32: the key needs int64
     key = E[:, 0] * nV + E[:, 1]                               # edges are sorted lexicographically
     k = P[:, 0] * nV + P[:, 1]

@@ -10,7 +10,8 @@ operator ``P / R`` and principal curvatures ``+1/R``.
 """
 from __future__ import annotations
 
-from typing import Any, Literal, overload
+from collections.abc import Sequence
+from typing import Any, Literal, Union, overload
 
 import igl  # noqa: F401  (imported with the public API, not inside the first call: its first call costs as the later ones)
 import numpy as np
@@ -514,29 +515,23 @@ def _curvature_kind(kind):
                      f"{', '.join(f'{a!r} = {c!r}' for a, c in CURVATURE_KIND_ALIASES.items())}), got {kind!r}")
 
 
+_Faces = Union[NDArray[np.integer[Any]], Sequence[Sequence[int]], None]
+"""The type of ``curvature_of``'s ``F``: an integer array or nested sequence, never a string (a
+quantity passed as ``F`` is a type error, for mypy too)."""
+
+
 @overload
-def curvature_of(mesh_or_V: Any, F: ArrayLike | None = None, kind: _Scalar = "mean",
+def curvature_of(mesh_or_V: Any, F: _Faces = None, *, kind: Literal["directions"],
+                 per: Literal["vertex", "face"] = "vertex",
+                 **kwargs: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
+
+
+@overload
+def curvature_of(mesh_or_V: Any, F: _Faces = None, *, kind: _Scalar = "mean",
                  per: Literal["vertex", "face"] = "vertex", **kwargs: Any) -> NDArray[np.float64]: ...
 
 
-@overload
-def curvature_of(mesh_or_V: Any, F: ArrayLike | None, kind: Literal["directions"],
-                 per: Literal["vertex", "face"] = "vertex",
-                 **kwargs: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
-
-
-@overload
-def curvature_of(mesh_or_V: Any, F: ArrayLike | None = None, *, kind: Literal["directions"],
-                 per: Literal["vertex", "face"] = "vertex",
-                 **kwargs: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
-
-
-@overload
-def curvature_of(mesh_or_V: Any, F: ArrayLike | None = None, kind: str = "mean", per: str = "vertex",
-                 **kwargs: Any) -> NDArray[np.float64] | tuple[NDArray[np.float64], NDArray[np.float64]]: ...
-
-
-def curvature_of(mesh_or_V: Any, F: ArrayLike | None = None, kind: str = "mean", per: str = "vertex",
+def curvature_of(mesh_or_V: Any, F: _Faces = None, *, kind: str = "mean", per: str = "vertex",
                  **kwargs: Any) -> NDArray[np.float64] | tuple[NDArray[np.float64], NDArray[np.float64]]:
     """One curvature quantity of a mesh as plain arrays, in one call (in the spirit of
     pyvista's ``mesh.curvature("mean")``).
@@ -552,11 +547,11 @@ def curvature_of(mesh_or_V: Any, F: ArrayLike | None = None, kind: str = "mean",
         triangulated ``pyvista.PolyData``, ``meshio.Mesh``).
     F : (#F, 3) array_like int, optional
         Triangles (required with arrays).
-    kind : {"mean", "gauss", "k1", "k2", "directions"}, default "mean"
+    kind : {"mean", "gauss", "k1", "k2", "directions"}, default "mean", keyword-only
         Mean curvature H = (κ1 + κ2)/2, Gauss curvature K = κ1 κ2, the principal
         curvatures κ1 ≥ κ2, or the principal directions.  ``"gaussian"``, ``"H"``
         and ``"K"`` are accepted as aliases (:data:`CURVATURE_KIND_ALIASES`).
-    per : {"vertex", "face"}, default "vertex"
+    per : {"vertex", "face"}, default "vertex", keyword-only
         "vertex": from the drop-in :func:`principal_curvature` (recovered and
         smoothed at ``radius``); "face": Walker's per-face S_h itself
         (:func:`face_mean_curvature`, :func:`face_gaussian_curvature`,
@@ -587,11 +582,14 @@ def curvature_of(mesh_or_V: Any, F: ArrayLike | None = None, kind: str = "mean",
     >>> from igl_hhj.surfaces import icosphere
     >>> V, F = icosphere(3)
     >>> H = igl_hhj.curvature_of(V, F)                        # per-vertex mean curvature
-    >>> K = igl_hhj.curvature_of(V, F, "gauss", per="face")   # Walker's S_h, per face
+    >>> K = igl_hhj.curvature_of(V, F, kind="gauss", per="face")   # Walker's S_h, per face
     >>> H.shape, K.shape, round(float(H.mean()), 2)
     ((642,), (1280,), 1.0)
     >>> PD1, PD2 = igl_hhj.curvature_of(V, F, kind="directions")
     """
+    if isinstance(F, (str, bytes)):
+        raise TypeError(f"curvature_of: F must be the faces, got the string {F!r}; the quantity is "
+                        f"keyword-only: curvature_of(mesh, kind={F!r}) or curvature_of(V, F, kind={F!r})")
     kind = _curvature_kind(kind)
     if per not in CURVATURE_PER:
         raise ValueError(f"per must be one of {', '.join(map(repr, CURVATURE_PER))}, got {per!r}")

@@ -100,6 +100,28 @@ def zero_area_faces(edge_vectors, double_areas):
         return _zero_area(np.asarray(double_areas), l2max)
 
 
+def check_mesh_size(squared_longest_edges):
+    """Raise ``ValueError`` ("too small: rescale") when the mesh's longest edge is below
+    :data:`MIN_MESH_SIZE`.
+
+    Parameters
+    ----------
+    squared_longest_edges : (#F,) float64, each face's squared longest edge
+
+    Below that size the squared cross products underflow to 0, so every face would look
+    degenerate (:func:`zero_area_faces`): this check comes before that one, in
+    :class:`TriangleMesh` and in :func:`igl_hhj.repair.repair_mesh`, else a repair would drop
+    every face and return NaN everywhere.
+    """
+    l2 = np.asarray(squared_longest_edges)
+    with np.errstate(invalid="ignore"):
+        h = float(np.sqrt(np.nanmax(l2))) if l2.size and not np.isnan(l2).all() else np.inf
+    if h < MIN_MESH_SIZE:
+        raise ValueError(f"the mesh is too small: its longest edge is {h:.3g} < "
+                         f"{MIN_MESH_SIZE:g} (squared areas underflow float64). Rescale it "
+                         f"(curvature scales as 1/length: compute on s V, multiply by s)")
+
+
 def _zero_area(dbl, l2max):
     """The criterion of :func:`zero_area_faces` from twice the areas and the squared longest edges."""
     with np.errstate(over="ignore", invalid="ignore"):
@@ -555,6 +577,7 @@ class TriangleMesh:
         cross, dbl, l2max = kernels.face_metrics(self.V, self.F)
         self.__dict__["_cross"] = cross
         self.__dict__["face_double_areas"] = dbl
+        check_mesh_size(l2max)      # first: below it every face would look degenerate
         bad = _zero_area(dbl, l2max)
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
@@ -578,11 +601,6 @@ class TriangleMesh:
                 f"{2 * area / longest ** 2:.2g} ≤ {DEGENERATE_AREA_RTOL:g}, below what libigl's "
                 f"edge-length formulas resolve): collapse the short edge or remove the sliver",
                 "degenerate")
-        h = float(np.sqrt(l2max.max()))
-        if h < MIN_MESH_SIZE:
-            raise ValueError(f"the mesh is too small: its longest edge is {h:.3g} < "
-                             f"{MIN_MESH_SIZE:g} (squared areas underflow float64). Rescale it "
-                             f"(curvature scales as 1/length: compute on s V, multiply by s)")
 
     def _check_manifold_and_orientation(self):
         count = self.edge_face_count

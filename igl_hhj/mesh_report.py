@@ -79,6 +79,7 @@ class MeshReport:
     n_zero_area_faces: int | None = None
     n_repeated_vertex_faces: int | None = None
     n_duplicate_faces: int | None = None
+    n_two_sided_faces: int | None = None
     bbox: tuple | None = None
     mean_edge_length: float | None = None
     repairs: dict | None = None
@@ -121,9 +122,12 @@ class MeshReport:
                 f"vertex-manifold   {yn[self.vertex_manifold]}"
                 + (f" ({self.n_nonmanifold_vertices} non-manifold vertices)"
                    if self.n_nonmanifold_vertices else ""),
-                "orientation       " + ("consistent" if self.consistently_oriented else
-                                        f"inconsistent ({self.n_misoriented_edges} edges traversed "
-                                        f"twice in the same direction)")
+                "orientation       " + (
+                    f"ambiguous ({self.n_two_sided_faces} faces also given reversed: a two-sided "
+                    f"sheet has no outside, the sign of its curvature is undefined)"
+                    if self.n_two_sided_faces else "consistent" if self.consistently_oriented else
+                    f"inconsistent ({self.n_misoriented_edges} edges traversed "
+                    f"twice in the same direction)")
                 + {True: ", orientable", False: ", non-orientable", None: ""}[self.orientable],
                 "degenerate faces  " + (f"{self.n_zero_area_faces} zero-area or sliver, " if self.n_zero_area_faces
                                         is not None else "zero-area not checked (non-finite coordinates), ")
@@ -174,6 +178,20 @@ def _repairs(V, F, defect):
         return R.summary, text + f"; the repaired mesh is still refused: {exc}"
     return R.summary, text + ("; principal_curvature computes on the repaired mesh, the strict "
                               "functions refuse it unless repair=True")
+
+
+def _two_sided_faces(F):
+    """(#F,) bool: faces whose three vertices are also given in the opposite orientation
+    (the parity of the permutation that sorts the corners differs)."""
+    if len(F) == 0:
+        return np.zeros(0, dtype=bool)
+    _, inverse = np.unique(np.sort(F, axis=1), axis=0, return_inverse=True)
+    inverse = np.asarray(inverse).ravel()
+    a, b, c = F.T
+    odd = ((a > b).astype(np.int8) + (a > c) + (b > c)) % 2 == 1
+    n = int(inverse.max()) + 1
+    both = (np.bincount(inverse, weights=odd, minlength=n) > 0) & (np.bincount(inverse, weights=~odd, minlength=n) > 0)
+    return both[inverse]
 
 
 def mesh_report(V: Any, F: Any, split: PolygonSplit | None = None) -> MeshReport:
@@ -250,6 +268,7 @@ def mesh_report(V: Any, F: Any, split: PolygonSplit | None = None) -> MeshReport
         rep.n_zero_area_faces = int((zero & ~repeated).sum())
         rep.mean_edge_length = float(np.linalg.norm(V[uE[:, 1]] - V[uE[:, 0]], axis=1).mean())
     rep.n_duplicate_faces = int(nF - len(igl.unique_simplices(F)[0]))
+    rep.n_two_sided_faces = int(_two_sided_faces(F).sum())
 
     # components, boundary loops, Euler characteristic per component
     n_comp, C = igl.facet_components(F)

@@ -217,6 +217,10 @@ def _repaired_dropin(exc, V, F, radius, useKring, opts):
         V2, F2, radius, useKring, opts.on_repaired(data), repair_defects=False),
         "principal curvatures", count_lost=True, stacklevel=6)
     PD1, PD2, PV1, PV2 = out[:4] if out is not None else (np.zeros((0, 3)),) * 2 + (np.zeros(0),) * 2
+    two_sided = repair.two_sided_vertices(R)          # no side is "out" there: no sign, no value
+    if two_sided.any():
+        for a in (PD1, PD2, PV1, PV2):
+            a[two_sided] = np.nan
     PD1, PD2, PV1, PV2 = repair.vertex_values_to_caller(R, PD1, PD2, PV1, PV2)
     bad = ~(np.isfinite(PD1).all(axis=1) & np.isfinite(PD2).all(axis=1) & np.isfinite(PV1) & np.isfinite(PV2))
     for a in (PD1, PD2, PV1, PV2):
@@ -254,6 +258,8 @@ def shape_operator(V, F, opts: Options, *, repair_defects=False):
         no_named_creases_on_repair(opts.crease_edges, exc)
         R, S = on_repaired_mesh(exc, V, F, opts.data_dict(), lambda V2, F2, data: shape_operator(
             V2, F2, opts.on_repaired(data)), "the shape operator", stacklevel=5)
+        if S is not None and R.two_sided is not None:     # a two-sided patch: no sign
+            S[R.two_sided] = np.nan
         return repair.face_values_to_caller(R, np.zeros((0, 3, 3)) if S is None else S)[0]
     groups_of = None
     if opts.creases:                                                             # 4. crease cut

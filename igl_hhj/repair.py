@@ -14,7 +14,10 @@ Repairs, in this order (all vectorised; loops run over components only)
 2. Degenerate faces (zero area, or relative area ≤ ``DEGENERATE_AREA_RTOL``,
    the criterion of :func:`igl_hhj.mesh.zero_area_faces`) are dropped.
 3. Duplicate faces (the same three vertices in any order, so reversed
-   duplicates too) are dropped but the first of each set.
+   duplicates too) are dropped but the first of each set.  A patch whose every
+   face was given in both orientations (a two-sided sheet) has no orientation:
+   the sign of its curvature is undefined, its faces are flagged
+   (:attr:`RepairedMesh.two_sided`) and the drop-in gives its vertices no value.
 4. Each patch of faces connected through edges with exactly two faces is
    oriented consistently (``igl.bfs_orient``), then flipped as a whole when
    the caller's orientation of that patch disagrees on more than half its
@@ -39,13 +42,13 @@ from typing import Any
 
 import numpy as np
 
-from .mesh import MeshWarning, validate_faces, validate_vertices, zero_area_faces
+from .mesh import MeshWarning, check_mesh_size, validate_faces, validate_vertices, zero_area_faces
 from .mesh_objects import mesh_arrays
 
 __all__ = ["RepairedMesh", "repair_mesh", "vertex_values_to_caller", "face_values_to_caller",
            "REPAIR_KINDS"]
 
-REPAIR_KINDS = ("repeated corner", "degenerate", "duplicate", "flipped", "non-orientable",
+REPAIR_KINDS = ("repeated corner", "degenerate", "duplicate", "two-sided", "flipped", "non-orientable",
                 "non-manifold")
 """Keys of :attr:`RepairedMesh.summary`, in the order of the repairs."""
 
@@ -71,7 +74,11 @@ class RepairedMesh:
         Counts per kind (:data:`REPAIR_KINDS`): faces dropped with a repeated
         corner, degenerate, duplicate; faces whose orientation was reversed
         ("flipped"); faces removed in non-orientable patches; extra vertex
-        copies made by splitting non-manifold edges / vertices ("non-manifold").
+        copies made by splitting non-manifold edges / vertices ("non-manifold");
+        faces of two-sided patches, whose orientation is undefined ("two-sided").
+    two_sided : (#F2,) bool or None
+        Faces of a patch whose every face was given in both orientations: the sign
+        of anything computed there is undefined (None: no such face).
     """
     V: np.ndarray
     F: np.ndarray
@@ -80,6 +87,7 @@ class RepairedMesh:
     n_vertices: int
     n_faces: int
     summary: dict = field(default_factory=dict)
+    two_sided: Any = None
 
     @property
     def repaired(self):
@@ -93,6 +101,8 @@ class RepairedMesh:
             "repeated corner": "faces with a repeated corner dropped",
             "degenerate": "degenerate (zero-area or sliver) faces dropped",
             "duplicate": "duplicate faces dropped (reversed duplicates included)",
+            "two-sided": "faces of two-sided patches (each face given in both orientations: the sign "
+                         "of the curvature is undefined there, their vertices get no value)",
             "flipped": "faces re-oriented to the majority orientation of their patch",
             "non-orientable": "faces of non-orientable (Möbius) patches removed",
             "non-manifold": "vertex copies made to split non-manifold edges/vertices",
@@ -193,15 +203,25 @@ def repair_mesh(V: Any, F: Any) -> RepairedMesh:
     repeated = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
     dbl, X = _double_areas(V, F)
     ev = np.stack([X[:, 2] - X[:, 1], X[:, 0] - X[:, 2], X[:, 1] - X[:, 0]], axis=1)
+    with np.errstate(over="ignore", invalid="ignore"):
+        check_mesh_size((ev ** 2).sum(axis=2).max(axis=1))      # "too small", not every face dropped
     degenerate = zero_area_faces(ev, dbl) & ~repeated
     keep = ~(repeated | degenerate)
     summary["repeated corner"] = int(repeated.sum())
     summary["degenerate"] = int(degenerate.sum())
 
-    # 3. duplicates (any vertex order): keep the first of each set
+    # 3. duplicates (any vertex order): keep the first of each set; a set given in both
+    # orientations (the parity of the permutation that sorts the corners) is two-sided
     idx = np.flatnonzero(keep)
+    two_sided = np.zeros(nF, dtype=bool)
     if len(idx):
-        first, = _unique_rows(np.sort(F[idx], axis=1), nV, return_index=True)
+        first, inverse = _unique_rows(np.sort(F[idx], axis=1), nV, return_index=True, return_inverse=True)
+        inverse = np.asarray(inverse).ravel()
+        a, b, c = F[idx].T
+        odd = ((a > b).astype(np.int8) + (a > c) + (b > c)) % 2 == 1
+        both = (np.bincount(inverse, weights=odd, minlength=len(first)) > 0) & \
+               (np.bincount(inverse, weights=~odd, minlength=len(first)) > 0)
+        two_sided[idx] = both[inverse]
         dup = np.ones(len(idx), dtype=bool)
         dup[first] = False
         summary["duplicate"] = int(dup.sum())
@@ -216,7 +236,8 @@ def repair_mesh(V: Any, F: Any) -> RepairedMesh:
     # as they are (it flips a face only against a neighbour): skip it (armadillo with one
     # non-manifold face: 0.11 s; a voxel soup of 85k patches: 1 s)
     Fk = F[idx]
-    if not _inconsistent_faces(Fk, nV).any():
+    ts = two_sided[idx]
+    if not ts.any() and not _inconsistent_faces(Fk, nV).any():
         O = Fk.copy()
     else:
         O, C = igl.bfs_orient(Fk)
@@ -224,17 +245,19 @@ def repair_mesh(V: Any, F: Any) -> RepairedMesh:
         C = np.asarray(C, dtype=np.int64).ravel()
         nC = int(C.max()) + 1
         flipped = ~_same_cycle(O, Fk)
-        w = dbl[idx]
+        w = dbl[idx] * ~ts                              # a two-sided face votes for neither side
         flip_area = np.bincount(C, weights=w * flipped, minlength=nC)
         total = np.bincount(C, weights=w, minlength=nC)
         back = flip_area > 0.5 * total                  # the caller's majority says the other way
+        ts = (total == 0)[C]                            # no face says which side is out: undefined
         O[back[C]] = O[back[C]][:, ::-1]
         bad_comp = np.zeros(nC, dtype=bool)
         bad_comp[C[_inconsistent_faces(O, nV)]] = True  # bfs_orient could not make it consistent
         good = ~bad_comp[C]
         summary["non-orientable"] = int((~good).sum())
         summary["flipped"] = int((~_same_cycle(O, Fk) & good).sum())
-        O, idx = O[good], idx[good]
+        O, idx, ts = O[good], idx[good], ts[good]
+    summary["two-sided"] = int(ts.sum())
     if len(idx) == 0:
         return RepairedMesh(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64),
                             np.zeros(0, dtype=np.int64), idx, nV, nF, summary)
@@ -251,7 +274,17 @@ def repair_mesh(V: Any, F: Any) -> RepairedMesh:
     n_ref = len(np.unique(O))
     summary["non-manifold"] = int(len(SVI) - n_ref)
     V2 = np.ascontiguousarray(V[SVI])                   # exact caller coordinates
-    return RepairedMesh(V2, np.ascontiguousarray(SF), SVI, idx, nV, nF, summary)
+    return RepairedMesh(V2, np.ascontiguousarray(SF), SVI, idx, nV, nF, summary, ts if ts.any() else None)
+
+
+def two_sided_vertices(repaired):
+    """(#V2,) bool: the repaired mesh's vertices on a face of a two-sided patch
+    (:attr:`RepairedMesh.two_sided`), whose curvature has no defined sign."""
+    R = repaired
+    out = np.zeros(len(R.vertex_map), dtype=bool)
+    if R.two_sided is not None:
+        out[R.F[R.two_sided].ravel()] = True
+    return out
 
 
 def vertex_values_to_caller(repaired, *arrays):

@@ -113,3 +113,102 @@ def compute_curvature(V, F, *, method="hhj", per="vertex", radius=None, keep_sha
     if method == "igl":
         return run(label, baselines.libigl_quadric, V, F, radius=radius), None
     return run(label, baselines.estimate, ESTIMATORS[method, per], V, F), None
+
+
+class MeshRefusedError(ValueError):
+    """The mesh of a file cannot be used: :class:`igl_hhj.mesh.TriangleMesh`'s message
+    (``defect``: a repairable :class:`~igl_hhj.mesh.MeshDefectError` refused because of ``strict``)."""
+
+    def __init__(self, message, defect=False):
+        super().__init__(message)
+        self.defect = defect
+
+
+def compute_curvature_repairing(V, F, *, strict=False, **options):
+    """:func:`compute_curvature` that repairs what :func:`igl_hhj.principal_curvature` repairs.
+
+    A mesh :class:`igl_hhj.mesh.TriangleMesh` refuses for a repairable defect
+    (:class:`igl_hhj.mesh.MeshDefectError`: non-manifold edges or vertices, duplicate,
+    reversed-duplicate or flipped faces, degenerate faces, repeated corners) is repaired
+    with :func:`igl_hhj.repair.repair_mesh`, the curvature is computed on the repaired mesh
+    and mapped back to the caller's rows, and one :class:`igl_hhj.mesh.MeshWarning` names
+    what was repaired: the drop-in's path (``igl-hhj curvature`` and ``batch``).
+
+    Parameters
+    ----------
+    V : (#V, 3) float64, F : (#F, 3) int
+        The mesh as read from the file.
+    strict : bool
+        Refuse a mesh that needs repair (the ``MeshDefectError``) instead (``--strict``).
+    **options
+        Those of :func:`compute_curvature`.
+
+    Returns
+    -------
+    est : CurvatureEstimate
+        One row per caller vertex (``per="vertex"``) or face (``per="face"``); rows left
+        without a usable face by the repair, and vertices of a two-sided patch (whose sign
+        is undefined), are NaN and listed in ``est.bad``.
+    S : (#F, 3, 3) float64 or None
+        The shape operator on the caller's faces (NaN on faces the repair dropped).
+    mesh : igl_hhj.mesh.TriangleMesh
+        The mesh computed on: the file's, or the repaired one.
+    repaired : igl_hhj.repair.RepairedMesh or None
+        The repaired mesh, None when the mesh needed no repair.
+
+    Raises
+    ------
+    MeshRefusedError
+        The mesh cannot be used (bad coordinates or indices, too small), or needs a repair
+        and ``strict`` is set.
+    """
+    from ..mesh import MeshDefectError, TriangleMesh
+    from ..pipeline import on_repaired_mesh
+    from ..repair import seams_not_warned
+    try:
+        mesh = TriangleMesh(V, F)
+    except MeshDefectError as exc:
+        if strict:
+            raise MeshRefusedError(str(exc), defect=True) from None
+        defect = exc
+    except (ValueError, TypeError) as exc:
+        raise MeshRefusedError(str(exc)) from None
+    else:
+        return compute_curvature(mesh.V, mesh.F, **options) + (mesh, None)
+    what = "principal curvatures" if options.get("per", "vertex") == "vertex" else "the shape operator"
+    try:
+        R, out = on_repaired_mesh(defect, V, F, {}, lambda V2, F2, _: compute_curvature(V2, F2, **options),
+                                  what, count_lost=True, stacklevel=2)
+    except ValueError as exc:                   # e.g. too small: the repair refuses it too
+        raise MeshRefusedError(str(exc)) from None
+    with seams_not_warned():     # its split vertices coincide on purpose (one warning: the repair's)
+        mesh = TriangleMesh(R.V, R.F)
+    return _to_caller(R, out) + (mesh, R)
+
+
+def _to_caller(R, out):
+    """``(est, S)`` on the repaired mesh ``R`` -> on the caller's rows (NaN rows listed bad)."""
+    from dataclasses import replace
+    from .. import repair
+    if out is None:                                   # every face dropped
+        raise MeshRefusedError("the repair dropped every face (see the warning): nothing left to compute on")
+    est, S = out
+    fields = ["k1", "k2", "H", "K"] + [d for d in ("d1", "d2") if getattr(est, d) is not None]
+    values = [getattr(est, f) for f in fields]
+    if est.location == "vertex":
+        ambiguous = repair.two_sided_vertices(R)
+        values = [np.where(ambiguous.reshape((-1,) + (1,) * (v.ndim - 1)), np.nan, v) for v in values]
+        mapped = repair.vertex_values_to_caller(R, *values)
+    else:
+        if R.two_sided is not None:
+            values = [np.where(R.two_sided.reshape((-1,) + (1,) * (v.ndim - 1)), np.nan, v) for v in values]
+        mapped = repair.face_values_to_caller(R, *values)
+    bad = ~np.all([np.isfinite(m).reshape(len(m), -1).all(axis=1) for m in mapped], axis=0)
+    for m in mapped:
+        m[bad] = np.nan
+    est = replace(est, bad=np.flatnonzero(bad), **dict(zip(fields, mapped)))
+    if S is not None:
+        if R.two_sided is not None:
+            S = np.where(R.two_sided[:, None, None], np.nan, S)
+        S = repair.face_values_to_caller(R, S)[0]
+    return est, S

@@ -14,12 +14,12 @@ import numpy as np
 
 from ..errors import MeshFileError
 from ..results import QUANTITIES
-from .compute import compute_curvature
+from .compute import MeshRefusedError, compute_curvature, compute_curvature_repairing
 
 
 PERCENTILES = (1, 50, 99)
 SUMMARY_COLUMNS = (["path", "output", "status", "vertices", "faces", "seconds", "cpu_seconds",
-                    "peak_memory", "error", "warnings"]
+                    "peak_memory", "error", "warnings", "polygons"]
                    + [f"{q}_p{p:02d}" for q in QUANTITIES for p in PERCENTILES] + ["nan_values"])
 """Columns of ``summary.csv``: ``seconds`` wall-clock and ``cpu_seconds`` CPU time (all
 threads of the process computing the mesh) from reading to writing; ``peak_memory`` in
@@ -27,7 +27,9 @@ bytes (the process's peak resident set during the mesh, Linux only, empty when u
 or when the worker runs several threads); ``warnings`` what the mesh's reading and
 computation warned about (libigl's reader messages, :class:`igl_hhj.mesh.MeshWarning`,
 numpy), one-line messages joined by `` | `` (empty: none), recorded where the mesh was
-computed, so Dask workers' warnings are not lost; ``k1_p01 ... K_p99`` the 1st/50th/99th
+computed, so Dask workers' warnings are not lost; ``polygons`` the file's polygons split
+into triangles ("12 quads split into 24 triangles ...", as ``igl-hhj curvature`` and ``info``
+say it: a note, not a warning; empty: triangles only); ``k1_p01 ... K_p99`` the 1st/50th/99th
 percentiles over the vertices or faces; ``nan_values`` the number of elements without a
 value."""
 TMP_MARK = ".igl-hhj-tmp"
@@ -99,6 +101,7 @@ class Options:
     timeout: float | None = None
     memory_limit: int | None = None
     feature_angle: float | None = None
+    strict: bool = False
 
     @property
     def sandboxed(self):
@@ -135,22 +138,23 @@ def process_mesh(job, options, measure_peak=True):
 
 def _compute_one(job, options, extra):
     """(status, error message, reader messages) of one mesh; statistics go into ``extra``."""
-    from ..mesh import TriangleMesh
-    from ..mesh_io import read_mesh
+    from ..mesh_io import read_mesh_file
     said = []
     try:
-        V, F, said = read_mesh(job.path)
-        said = list(said)
+        mf = read_mesh_file(job.path)
+        V, F, said = mf.V, mf.F, list(mf.messages)
+        if mf.split.n_split:              # a note of its own, not a warning (as curvature / info)
+            extra["polygons"] = mf.split.describe()
         extra.update(vertices=len(V), faces=len(F))
-        try:
-            mesh = TriangleMesh(V, F)
-        except (ValueError, TypeError) as exc:
-            raise MeshFileError(f"{job.path}: igl_hhj cannot use this mesh: {exc}") from None
-        est, S = compute_curvature(mesh.V, mesh.F, method=options.method, per=options.per,
-                                   radius=options.radius,
-                                   keep_shape_operator=options.fmt == "npz",
-                                   feature_angle=options.feature_angle)
-        _atomic_write(job.output, options.fmt, mesh.V, mesh.F, est, options.method, S)
+        try:          # what the drop-in repairs is repaired (one warning), unless strict
+            est, S, _, _ = compute_curvature_repairing(V, F, strict=options.strict, method=options.method,
+                                                       per=options.per, radius=options.radius,
+                                                       keep_shape_operator=options.fmt == "npz",
+                                                       feature_angle=options.feature_angle)
+        except MeshRefusedError as exc:
+            raise MeshFileError(f"{job.path}: igl_hhj cannot use this mesh: {exc}"
+                                + (" (--strict)" if exc.defect else "")) from None
+        _atomic_write(job.output, options.fmt, V, F, est, options.method, S)
         extra.update(_percentile_stats(est))
         status, message = "ok", None
     except MemoryError:

@@ -40,13 +40,26 @@ def describe_options(key):
 
 
 def _read_options_file(outdir):
+    """The entries of ``OUTDIR/OPTIONS_FILE`` ({} when there is none).  A file that is not one
+    (not JSON, nested beyond the parser's recursion limit, not an object) is a ``ValueError``
+    naming it: a usage error of ``igl-hhj batch``, not a failed computation."""
     import json
+    path = Path(outdir) / OPTIONS_FILE
     try:
-        with open(Path(outdir) / OPTIONS_FILE) as fh:
+        with open(path) as fh:
             data = json.load(fh)
-        return data if isinstance(data, dict) else {}
-    except (OSError, ValueError):
+    except FileNotFoundError:
         return {}
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot read the options file: {exc.strerror or exc}") from None
+    except (ValueError, RecursionError) as exc:
+        why = "nested too deeply" if isinstance(exc, RecursionError) else f"not JSON: {exc}"
+        raise ValueError(f"{path}: not an igl-hhj options file ({why}); delete it to recompute "
+                         f"every output, or choose another output folder") from None
+    if not isinstance(data, dict):
+        raise ValueError(f"{path}: not an igl-hhj options file (a JSON {type(data).__name__}, not an "
+                         f"object); delete it to recompute every output, or choose another output folder")
+    return data
 
 
 def _write_options_file(outdir, entries):
@@ -61,6 +74,10 @@ def _write_options_file(outdir, entries):
 def _made_with(entry, output):
     """The options ``output`` was computed with according to its entry, or None."""
     if not isinstance(entry, dict) or not isinstance(entry.get("options"), dict):
+        return None
+    opts = entry["options"]        # only a key options_key could have written (else: unknown, recomputed)
+    if not {"method", "per", "radius"} <= set(opts) <= {"method", "per", "radius", "feature_angle"} \
+            or not all(v is None or isinstance(v, (str, int, float)) for v in opts.values()):
         return None
     if entry.get("done"):
         return entry["options"]

@@ -62,8 +62,19 @@ def _in_process(groups, options, on_row):
             on_row(run_group([job], options)[0])
 
 
+NO_WORKER_SECONDS = 120.0
+"""How long the tasks may wait with no worker in the cluster before their meshes become error
+rows.  A worker whose event loop stops answering (a parser stuck in C code holding the GIL) is
+dropped by the scheduler after ``distributed.scheduler.worker-ttl`` (300 s); its nanny then shuts
+down for good instead of restarting it (dask/distributed#8537), and with ``--workers 1`` nothing
+is left to run the remaining tasks: ``as_completed`` waited forever (the hangs of 110 s and
+300 s and more)."""
+WATCH_SECONDS = 5.0
+"""How often the client checks that the cluster still has workers while no task finishes."""
+
+
 def _on_dask(client, groups, options, on_row, retry_singles=True):
-    from distributed import as_completed
+    from distributed import wait
     futures = {}
 
     def submit(group, attempt):
@@ -73,24 +84,46 @@ def _on_dask(client, groups, options, on_row, retry_singles=True):
         futures[fut] = (group, attempt)
         return fut
 
-    ac = as_completed([submit(g, 0) for g in groups])
+    def finished(fut):
+        group, attempt = futures.pop(fut)
+        try:
+            rows = fut.result()
+        except Exception as exc:             # the task failed without producing rows
+            if len(group) > 1 and retry_singles:
+                for job in group:              # isolate the mesh that kills its worker
+                    submit([job], attempt + 1)
+                return
+            what = ("the worker process computing it died every time it was tried (a crash "
+                    "or out of memory; Dask's distributed.scheduler.allowed-failures retries)"
+                    if type(exc).__name__ == "KilledWorker" else
+                    f"{type(exc).__name__}: {' '.join(str(exc).split())}")
+            rows = [_row(job, "error", error=f"{job.path}: {what}") for job in group]
+        for row in rows:
+            on_row(row)
+
+    for g in groups:
+        submit(g, 0)
+    no_worker_since = None
     try:
-        for fut in ac:
-            group, attempt = futures.pop(fut)
+        while futures:
             try:
-                rows = fut.result()
-            except Exception as exc:             # the task failed without producing rows
-                if len(group) > 1 and retry_singles:
-                    for job in group:              # isolate the mesh that kills its worker
-                        ac.add(submit([job], attempt + 1))
-                    continue
-                what = ("the worker process computing it died every time it was tried (a crash "
-                        "or out of memory; Dask's distributed.scheduler.allowed-failures retries)"
-                        if type(exc).__name__ == "KilledWorker" else
-                        f"{type(exc).__name__}: {' '.join(str(exc).split())}")
-                rows = [_row(job, "error", error=f"{job.path}: {what}") for job in group]
-            for row in rows:
-                on_row(row)
+                done, _ = wait(list(futures), timeout=WATCH_SECONDS, return_when="FIRST_COMPLETED")
+            except TimeoutError:
+                done = ()
+            for fut in done:
+                finished(fut)
+            if done or client.scheduler_info().get("workers"):
+                no_worker_since = None
+                continue
+            no_worker_since = no_worker_since or time.monotonic()
+            if time.monotonic() - no_worker_since > NO_WORKER_SECONDS:
+                client.cancel(list(futures))
+                for group, _ in list(futures.values()):
+                    for job in group:
+                        on_row(_row(job, "error", error=f"{job.path}: no worker process left to compute "
+                                                        f"it for {NO_WORKER_SECONDS:g} s (they died or "
+                                                        f"stopped answering; rerun to retry)"))
+                futures.clear()
     finally:
         if futures:
             client.cancel(list(futures))
@@ -148,9 +181,18 @@ def _import_distributed():
                           f"{install_hint('distributed')} (or --workers 0: in-process)") from None
 
 
+def _written_since(path, t_ns):
+    """Whether ``path`` exists and was written after ``t_ns`` (``time.time_ns()``)."""
+    try:
+        return os.stat(path).st_mtime_ns > t_ns
+    except OSError:
+        return False
+
+
 def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per="vertex",
               radius=None, fmt="npz", resume=True, timeout=None, memory_limit=None, retries=2,
-              group_bytes=GROUP_BYTES, progress=True, stream=None, client=None, feature_angle=None):
+              group_bytes=GROUP_BYTES, progress=True, stream=None, client=None, feature_angle=None,
+              strict=False):
     """Curvature of every mesh in ``inputs``; one output per mesh and a summary.
 
     Parameters
@@ -167,6 +209,10 @@ def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per
         per task); 0: run in this process.  Ignored with ``scheduler``.
     method, per, radius, feature_angle
         As ``igl-hhj curvature`` (:func:`compute_curvature`).
+    strict : bool
+        Refuse (an error row) a mesh that :func:`igl_hhj.principal_curvature` would repair;
+        default: repair it the same way, the repair named in the row's warnings
+        (:func:`igl_hhj.batch.compute.compute_curvature_repairing`).
     fmt : {"npz", "ply", "vtp", "vtu"}
     resume : bool
         Skip inputs whose output is newer than the input (status ``skipped``).
@@ -206,7 +252,7 @@ def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per
     if not jobs:
         raise ValueError("no input meshes")
     options = Options(method, per, None if radius is None else int(radius), fmt, timeout, memory_limit,
-                      None if feature_angle is None else float(feature_angle))
+                      None if feature_angle is None else float(feature_angle), bool(strict))
     previous = _previous_rows(outdir / "summary.csv")
     key = options_key(method, per, radius, feature_angle)
     made = _read_options_file(outdir)
@@ -287,6 +333,13 @@ def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per
         if box is not None:
             box.close()
         sweep_temporaries(outdir)
+        if interrupted:          # outputs the workers finished after the interrupt reached us
+            for job in todo:
+                if job.path not in rows and _written_since(job.output, now):
+                    row = _skipped_row(job, {})            # its statistics re-read from the .npz
+                    row.update(status="ok", warnings="finished by a worker after Ctrl-C (no timings)")
+                    rows[job.path] = row                   # into the summary (the bar is closed)
+                    made[rel[job.path]]["done"] = True
         if todo:
             _write_options_file(outdir, made)
         done = [rows[j.path] for j in jobs if j.path in rows]

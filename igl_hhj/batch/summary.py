@@ -44,7 +44,7 @@ def write_summary(rows, outdir):
         vals = [None if v in ("", None) else v for v in vals]
         if c in ("vertices", "faces", "peak_memory", "nan_values"):
             cols[c] = pa.array([None if v is None else int(v) for v in vals], pa.int64())
-        elif c in ("path", "output", "status", "error", "warnings"):
+        elif c in ("path", "output", "status", "error", "warnings", "polygons"):
             cols[c] = pa.array([None if v is None else str(v) for v in vals], pa.string())
         else:
             cols[c] = pa.array([None if v is None else float(v) for v in vals], pa.float64())

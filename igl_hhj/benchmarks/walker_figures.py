@@ -12,7 +12,7 @@ Writes ``walker_fig3_saddle.png``, ``walker_fig4_dumbbell.png``, ``walker_fig5_t
 those of :mod:`.walker_tables` (k = 1: 1792, 2432, 7616, 11176 triangles); the zooms
 are the regions the captions name (saddle: a corner region, dumbbell: the top curved
 edge, torus: the inner hole, genus 3: the edge of the right hole).  Rendered headless
-by polyscope (EGL), composed with a colour bar by matplotlib, stored as palette PNGs.
+by polyscope (EGL), composed with a colour bar by matplotlib, stored as full-colour PNGs.
 """
 from __future__ import annotations
 
@@ -63,7 +63,7 @@ def _render(ps, eye, target, size):
 
 
 def render_figure(name, path, size=(760, 600), data=None):
-    """Render Walker's figure for ``name`` into ``path`` (palette PNG). Returns the data dict."""
+    """Render Walker's figure for ``name`` into ``path`` (full-colour PNG). Returns the data dict."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

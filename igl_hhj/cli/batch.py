@@ -34,7 +34,7 @@ def _batch(args):
         result = batch.run_batch(args.inputs, args.out, scheduler=args.scheduler,
                                  workers=args.workers, method=args.method, per=args.per,
                                  radius=args.radius, fmt=args.format, resume=args.resume,
-                                 feature_angle=args.feature_angle,
+                                 feature_angle=args.feature_angle, strict=args.strict,
                                  timeout=args.timeout, memory_limit=args.memory_limit,
                                  progress=not args.quiet,
                                  group_bytes=(batch.GROUP_BYTES if args.group_bytes is None
@@ -93,6 +93,8 @@ def add_parser(sub):
                    help="as for 'igl-hhj curvature': hhj smoothing scale (default 5 per vertex, 0 per face), igl k-ring")
     b.add_argument("--feature-angle", type=float, default=None, metavar="DEG",
                    help="as for 'igl-hhj curvature': hhj with creases above DEG degrees (default off)")
+    b.add_argument("--strict", action="store_true",
+                   help="as for 'igl-hhj curvature': refuse (error row) a mesh the drop-in would repair")
     b.add_argument("--format", choices=list(batch_formats()), default="npz",
                    help="npz (default; same content as 'igl-hhj curvature -o X.npz'), ply, or "
                         "vtp / vtu (ParaView, pyvista)")

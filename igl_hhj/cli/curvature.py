@@ -18,8 +18,8 @@ LARGE_MESH_FACES = 100_000
 
 
 def _curvature(args):
-    from ..batch import check_curvature_options, compute_curvature, default_radius
-    from ..mesh import TriangleMesh
+    from ..batch import check_curvature_options, default_radius
+    from ..batch.compute import MeshRefusedError, compute_curvature_repairing
 
     say = _say(args)
     if args.tile_faces is not None:            # out of core, tile by tile (igl_hhj.tiled)
@@ -48,30 +48,33 @@ def _curvature(args):
     t = time.perf_counter()
     mf = _read(args.mesh)
     V, F = mf.V, mf.F
-    try:
-        mesh = TriangleMesh(V, F)
-    except (ValueError, TypeError) as exc:
-        raise UserError(f"{args.mesh}: igl_hhj cannot use this mesh: {exc} "
-                        f"(run 'igl-hhj info {args.mesh}' for a diagnosis)") from None
     t_read = time.perf_counter() - t
-    large = mesh.n_faces > LARGE_MESH_FACES and not args.quiet
+    large = len(F) > LARGE_MESH_FACES and not args.quiet
     keep_S = args.out is not None and Path(args.out).suffix.lower() == ".npz"
     n_stages = (2 + (keep_S and args.method == "hhj") + (args.out is not None)
                 + (args.screenshot is not None))
     stages = _Stages(n_stages, large)
-    stages.done(f"reading and validating {mesh.n_faces} faces", t_read)
+    stages.done(f"reading {len(F)} faces", t_read)
 
     radius = args.radius if args.radius is not None else default_radius(args.method, per)
 
     t = time.perf_counter()
-    est, S = compute_curvature(mesh.V, mesh.F, method=args.method, per=per,
-                               radius=args.radius,
-                               keep_shape_operator=keep_S, run=stages.run,
-                               feature_angle=args.feature_angle)
+    try:             # what the drop-in repairs is repaired (one warning line), unless --strict
+        est, S, mesh, R = compute_curvature_repairing(
+            V, F, strict=args.strict, method=args.method, per=per, radius=args.radius,
+            keep_shape_operator=keep_S, run=stages.run, feature_angle=args.feature_angle)
+    except MeshRefusedError as exc:
+        strict = (" (--strict; without it the mesh is repaired as igl_hhj.principal_curvature does)"
+                  if exc.defect else "")
+        raise UserError(f"{args.mesh}: igl_hhj cannot use this mesh: {exc}{strict} "
+                        f"(run 'igl-hhj info {args.mesh}' for a diagnosis)") from None
     dt = time.perf_counter() - t
+    shown_est = est                  # the summary, the creases and the viewer: on the repaired mesh
+    if R is not None:
+        shown_est = _rows_of(est, R.vertex_map if est.location == "vertex" else R.face_map)
 
-    say(f"{args.mesh}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, "
-          f"{int(mesh.boundary_edges.sum())} boundary edges")
+    say(f"{args.mesh}: {len(V)} vertices, {len(F)} faces, "
+          f"{int(mesh.boundary_edges.sum())} boundary edges" + ("" if R is None else " (after the repair)"))
     if mf.split.n_split:
         say(f"  {mf.split.describe()}")
     say(f"  method {args.method} per {per}: {dt:.2f} s")
@@ -92,17 +95,19 @@ def _curvature(args):
         say(f"  {name:>3}: 1% {q[0]: .4g}   median {q[1]: .4g}   99% {q[2]: .4g}")
     n_nan = int(np.isnan(est.k1).sum())
     if n_nan:
-        say(f"  {n_nan} {'vertice' if per == 'vertex' else 'face'}s have no value (NaN): "
-            f"{_nan_reasons(mesh, est, args.method)}")
+        why = (_nan_reasons(mesh, est, args.method) if R is None else
+               "left without a usable face by the repair, or on a two-sided patch (no outside: "
+               "no sign), or as on a clean mesh")
+        say(f"  {n_nan} {'vertice' if per == 'vertex' else 'face'}s have no value (NaN): {why}")
 
     if args.out is not None:
-        _write(stages, args, mesh, est, S)
+        _write(stages, args, V, F, est, S)
 
     if args.screenshot is not None or args.view:
         viewer = _viewer()
         name = Path(args.mesh).stem
         robust = args.robust if args.robust > 0 else None
-        shown = dict(estimate=est, name=name, robust=robust, enabled=args.quantity, view=args.camera)
+        shown = dict(estimate=shown_est, name=name, robust=robust, enabled=args.quantity, view=args.camera)
         def creases():           # --feature-angle: the crease network on the surface, coloured by θ_e
             if args.feature_angle is None or args.method != "hhj":
                 return []
@@ -154,10 +159,19 @@ def _nan_reasons(mesh, est, method):
     return ", ".join(parts)
 
 
-def _write(stages, args, mesh, est, S):
+def _rows_of(est, rows):
+    """``est`` restricted to the rows ``rows`` (the repaired mesh's vertices or faces)."""
+    from dataclasses import replace
+    take = {f: getattr(est, f)[rows] for f in ("k1", "k2", "H", "K", "d1", "d2") if getattr(est, f) is not None}
+    bad = ~np.isfinite(take["k1"])
+    return replace(est, bad=np.flatnonzero(bad), **take)
+
+
+def _write(stages, args, V, F, est, S):
+    """``est`` (and ``S``) on the file's own ``V``, ``F`` (the caller's rows, as the drop-in)."""
     from ..mesh_io import write_curvature
     try:
-        stages.run(f"writing {args.out}", write_curvature, args.out, mesh.V, mesh.F, est,
+        stages.run(f"writing {args.out}", write_curvature, args.out, V, F, est,
                    method=args.method, S=S, quantity=args.quantity)
     except OSError as exc:
         raise UserError(f"{args.out}: cannot write: {exc.strerror or exc}") from None
@@ -208,6 +222,11 @@ def add_parser(sub):
     c.add_argument("--robust", type=float, default=1.0, metavar="P",
                    help="colour range of --view/--screenshot from the P-th to the (100-P)-th "
                         "percentile (default 1; 0: full range)")
+    c.add_argument("--strict", action="store_true",
+                   help="refuse a mesh that igl_hhj.principal_curvature would repair (non-manifold "
+                        "edges or vertices, duplicate, two-sided or flipped faces, degenerate faces, "
+                        "repeated corners); default: repair it as the drop-in does, with one warning "
+                        "naming the repairs, values on the file's own vertices/faces")
     c.add_argument("-q", "--quiet", action="store_true",
                    help=f"print nothing but warnings and errors: no summary on stdout, no progress "
                         f"lines (stderr, meshes > {LARGE_MESH_FACES} faces)")

@@ -28,7 +28,7 @@ def build_parser():
                      description="igl_hhj: convergent finite-element (HHJ) curvature of triangle meshes.",
                      epilog="exit codes: 0 ok, 1 info: mesh rejected, 2 user error, 3 unreadable "
                             "mesh file, 4 solver failure, 5 out of memory, 70 internal error, "
-                            "130 interrupted")
+                            "130 interrupted, 141 output pipe closed (e.g. | head)")
     parser.add_argument("--debug", action="store_true",
                         help="show the Python traceback of a failure (anywhere on the command line)")
     parser.add_argument("--version", action="version", version=_version(),
@@ -82,6 +82,24 @@ def _failure(exc):
                                      f"{exc.strerror or exc}")
     return EXIT_INTERNAL, (f"internal error: {type(exc).__name__}: {_one_line(exc)} (please "
                            f"report it; rerun with --debug for the traceback)")
+
+
+EXIT_BROKEN_PIPE = 128 + 13
+"""The reader of stdout went away (``igl-hhj info m.off | head -3``): no message, the exit
+status of a process ended by SIGPIPE, as the Unix tools."""
+
+
+def _stdout_closed():
+    """Quiet end after a broken pipe: stdout points to /dev/null from here on, so the
+    interpreter's final flush cannot fail again (it would print 'Exception ignored')."""
+    import os
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError, AttributeError):   # no real stdout (captured): nothing to redirect
+        pass
+    return EXIT_BROKEN_PIPE
 
 
 _SIGINT_SEEN = [False]
@@ -146,6 +164,8 @@ def main(argv=None):
                 return exc.code if isinstance(exc.code, int) else 0
             except KeyboardInterrupt:
                 raise
+            except BrokenPipeError:
+                return _stdout_closed()
             except Exception as exc:
                 if _SIGINT_SEEN[0]:            # e.g. pybind11 turned the interrupt into ImportError
                     raise KeyboardInterrupt from exc

@@ -3,7 +3,7 @@
     igl-hhj demo compare_curvature                         # generated jittered torus, interactive
     igl-hhj demo compare_curvature path/to/mesh.off        # any file igl.read_triangle_mesh reads
     igl-hhj demo compare_curvature --screenshot out.png    # headless (EGL)
-    igl-hhj demo compare_curvature MESH --quantity K --per vertex --robust 5 --screenshot out.png
+    igl-hhj demo compare_curvature MESH --quantity K --per face --robust 5 --screenshot out.png
 
 What you see: two copies of the mesh side by side, coloured by one curvature
 (--quantity: k1, k2, mean H (default) or Gauss K) with a diverging map
@@ -11,8 +11,8 @@ What you see: two copies of the mesh side by side, coloured by one curvature
 white = zero curvature, red = positive, blue = negative; the range runs to the
 1st/99th percentile of both methods' values (--robust 1, the default; --robust
 0 uses the extremes), so a few outliers do not wash the picture out.  Left:
-igl_hhj (Walker's HHJ shape operator, one value per face with --per face, or
-the drop-in per-vertex recovery with --per vertex).  Right:
+igl_hhj (the drop-in per-vertex values by default, like with like beside libigl's;
+Walker's HHJ shape operator itself, one value per face, with --per face).  Right:
 igl.principal_curvature (quadric fit over a 5-ring, per vertex).  On the
 default generated mesh (Walker's torus (x²+y²-0.6)² + 1.5z² = 0.25, jittered,
 tilted towards the camera) H is red on the outer side and white to pale blue
@@ -99,8 +99,9 @@ def main(argv=None, prog=None):
     p.add_argument("--surface", default="torus", choices=["torus", "ellipsoid"],
                    help="generated surface when no mesh file is given (default: Walker's torus)")
     p.add_argument("--quantity", default="H", choices=list(QUANTS), help="quantity shown (default H)")
-    p.add_argument("--per", default="face", choices=["face", "vertex"],
-                   help="HHJ values per face (native S_h, default) or per vertex (drop-in)")
+    p.add_argument("--per", default="vertex", choices=["vertex", "face"],
+                   help="HHJ values per vertex (the drop-in, default: like with like beside libigl's "
+                        "per-vertex values) or per face (Walker's native S_h)")
     p.add_argument("--robust", type=float, default=1.0, metavar="P",
                    help="colour range from the [P, 100-P] percentiles of both methods' values "
                         "(default 1; 0 = the extremes)")

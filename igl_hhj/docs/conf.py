@@ -20,7 +20,28 @@ myst_enable_extensions = ["dollarmath"]
 myst_heading_anchors = 3
 html_theme = "furo"
 html_title = "igl_hhj"
+# code blocks wrap long lines rather than run off the right edge (_static/custom.css)
+html_static_path = ["_static"]
+html_css_files = ["custom.css"]
 exclude_patterns = ["_build"]
-# the (string) annotations keep numpy's alias names: curvature_of's overloads are shown
-# as signatures, where the expanded ArrayLike union would fill several lines
+# the (string) annotations keep numpy's alias names, where the expanded ArrayLike union would
+# fill several lines (api.rst gives curvature_of one signature instead of its overloads)
 autodoc_type_aliases = {"ArrayLike": "numpy.typing.ArrayLike", "NDArray": "numpy.typing.NDArray"}
+
+
+SINGLE_SIGNATURE = {"igl_hhj.curvature": {"curvature_of"}}
+"""Overloaded functions the API page shows with their one implementation signature (the
+parameter types under it): autodoc would open their entry with every ``@overload`` (they
+exist for type checkers: ``kind="directions"`` returns a pair)."""
+
+
+def setup(app):
+    from sphinx.pycode import ModuleAnalyzer
+    analyze = ModuleAnalyzer.analyze
+
+    def without_overloads(self):
+        analyze(self)
+        for name in SINGLE_SIGNATURE.get(self.modname, ()):
+            self.overloads.pop(name, None)
+
+    ModuleAnalyzer.analyze = without_overloads

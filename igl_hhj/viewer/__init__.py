@@ -64,7 +64,6 @@ from .curved import show_curved_field
 from .fields import (register_biharmonic, register_creases, register_hessian, register_regge_curvature,
                      register_scalars)
 from .registration import REPR_PNG_SIZE, QuantityInfo, Registration, merge, screenshot, to_image
-from .render import PNG_COLOURS
 from .values import (LABELS, LENGTH_UNIT, LONG_LABELS, METHOD_TITLES, METHODS, QUANTITIES, color_range,
                      local_edge_length)
 
@@ -74,5 +73,5 @@ __all__ = [
     "register_curvature", "register_comparison", "register_hessian", "register_biharmonic",
     "register_regge_curvature", "register_scalars", "register_result", "register_creases", "merge", "screenshot",
     "VIEWS", "best_view_direction", "view_rotation", "to_image", "REPR_PNG_SIZE", "show_curved_field",
-    "LABELS", "LENGTH_UNIT", "LONG_LABELS", "METHOD_TITLES", "PANEL_PX", "PNG_COLOURS",
+    "LABELS", "LENGTH_UNIT", "LONG_LABELS", "METHOD_TITLES", "PANEL_PX",
 ]

@@ -185,7 +185,7 @@ def _check_sizes(mesh, ests):
                              f"the mesh has {n} {e.location}s")
 
 
-def register_comparison(V: Any, F: Any = None, *, hhj=None, libigl=None, per="face", layout="copy", name="mesh", enabled="H",
+def register_comparison(V: Any, F: Any = None, *, hhj=None, libigl=None, per="vertex", layout="copy", name="mesh", enabled="H",
                         directions=True, show_directions=False, symmetric=True, robust=1.0, cmap="coolwarm", offset=None,
                         direction_scale=0.5, radius=5, view=None, title=None, screenshot=None, size=(1600, 800)) -> Registration:
     """HHJ curvature beside ``igl.principal_curvature`` on the same mesh, identical colour ranges.
@@ -195,7 +195,9 @@ def register_comparison(V: Any, F: Any = None, *, hhj=None, libigl=None, per="fa
     V, F : mesh
     hhj, libigl : CurvatureEstimate, optional precomputed results (HHJ at
         faces or vertices; libigl at vertices).
-    per : {"face", "vertex"}, where the HHJ values live if computed here.
+    per : {"vertex", "face"}, where the HHJ values live if computed here; default "vertex",
+        like with like beside libigl's per-vertex values ("face": Walker's S_h per face,
+        which looks mottled beside a per-vertex field at the same colour range).
     layout : {"copy", "quantities"}
         "copy": two structures, ``"<name> HHJ"`` and ``"<name> libigl"``, the
         libigl one translated by ``offset``; "quantities": one structure

@@ -136,8 +136,8 @@ REPR_PNG_SIZE = (640, 480)
 
 def to_image(registration: Any = None, *, size: tuple[int, int] = (1024, 768),
              annotate: bool = True) -> NDArray[np.uint8]:
-    """The picture :func:`screenshot` would write, as an array instead of a PNG file (in full
-    colour: the file is reduced to a palette of at most :data:`PNG_COLOURS` colours).
+    """The picture :func:`screenshot` would write, as an array instead of a PNG file (the
+    same pixels: the file is full-colour RGB).
 
     Parameters
     ----------

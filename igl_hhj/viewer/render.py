@@ -1,5 +1,5 @@
 """Pictures: the headless render of registered structures with titles and colour bars
-composited on (matplotlib), and the PNG files (a palette PNG with Pillow)."""
+composited on (matplotlib), and the PNG files (full-colour RGB with Pillow)."""
 from __future__ import annotations
 
 import os
@@ -135,41 +135,25 @@ def _polyscope_screenshot_with_bars(ps, reg, quantities, path):
 
 
 def _write_screenshot(ps, path, include_UI=False):
-    """polyscope's render as a palette PNG (:func:`save_png`), or as polyscope writes it
-    when Pillow is missing."""
+    """polyscope's render as a PNG (:func:`save_png`), or as polyscope writes it when Pillow
+    is missing."""
     image = np.asarray(ps.screenshot_to_buffer(transparent_bg=False, include_UI=include_UI))
     if not save_png(path, image):
         ps.screenshot(path, transparent_bg=False, include_UI=include_UI)
 
 
-PNG_COLOURS = 256
-"""Screenshots are written as palette PNGs of at most this many colours (with Pillow)."""
+def save_png(path, image):
+    """Write an (h, w, 3|4) uint8 image as a full-colour RGB PNG (every pixel as rendered:
+    a smooth field shows no bands; a 256-colour palette quantised smooth fields into steps).
 
-
-def save_png(path, image, keep=None):
-    """Write an (h, w, 3|4) uint8 image as a palette PNG of at most :data:`PNG_COLOURS`
-    colours (several times smaller than full RGB, the picture unchanged to the eye).
-
-    The palette is a median cut of the image plus the colours ``keep`` ((k, 3) uint8,
-    e.g. samples of the colour bars' maps, so that a bar stays a smooth ramp); every
-    pixel gets its nearest palette colour (no dithering: smooth shading compresses
-    well and shows no noise).  Returns False (nothing written) when Pillow is missing.
+    Returns False (nothing written) when Pillow is missing.
     """
     try:
         from PIL import Image
     except ImportError:
         return False
     img = Image.fromarray(np.ascontiguousarray(np.asarray(image, dtype=np.uint8)[..., :3]), "RGB")
-    keep = np.zeros((0, 3), np.uint8) if keep is None else np.asarray(keep, dtype=np.uint8).reshape(-1, 3)
-    keep = np.unique(keep, axis=0)[: PNG_COLOURS // 2]
-    cut = img.quantize(colors=PNG_COLOURS - len(keep), method=0)            # 0: median cut
-    flat = np.asarray(cut.getpalette() or [], dtype=np.uint8)
-    found = flat[: len(flat) // 3 * 3].reshape(-1, 3)
-    used = np.unique(np.asarray(cut)).astype(np.int64)
-    colours = np.concatenate([found[used[used < len(found)]], keep])
-    palette = Image.new("P", (1, 1))
-    palette.putpalette(colours.ravel().tolist() + colours[:1].ravel().tolist() * (256 - len(colours)))
-    img.quantize(palette=palette, dither=0).save(os.fspath(path), format="PNG", optimize=True)
+    img.save(os.fspath(path), format="PNG", optimize=True)
     return True
 
 
@@ -269,9 +253,7 @@ def _compose(path, image, size, bars, titles, font):
     canvas.draw()
     if path is None:
         return np.array(canvas.buffer_rgba(), dtype=np.uint8)    # (h, w, 4): figsize × dpi
-    ramps = [_mpl_cmap(cmap)(np.linspace(0.0, 1.0, 48))[:, :3] for _, _, cmap in bars]
-    keep = np.round(255 * np.concatenate(ramps)) if ramps else None
-    if not save_png(path, np.asarray(canvas.buffer_rgba()), keep):
+    if not save_png(path, np.asarray(canvas.buffer_rgba())):
         fig.savefig(path, dpi=dpi, facecolor="white")
     return None
 

@@ -266,7 +266,7 @@ def test_failed_run_keeps_existing_output(tmp_path, capsys):
     bad = write_off(tmp_path / "nm.off", *NONMANIFOLD)
     out = tmp_path / "k.csv"
     out.write_text("previous results\n")
-    assert cli.main(["curvature", str(bad), "-o", str(out)]) == 2
+    assert cli.main(["curvature", str(bad), "-o", str(out), "--strict"]) == 2
     one_error_line(capsys.readouterr().err)
     assert out.read_text() == "previous results\n"
 
@@ -304,10 +304,10 @@ def test_curvature_screenshot(sphere, tmp_path, capsys):
     assert code == 0 and png.stat().st_size > 0 and str(png) in cap.out
 
 
-def test_screenshots_are_annotated_palette_pngs(sphere, tmp_path, monkeypatch, capsys):
+def test_screenshots_are_annotated_full_colour_pngs(sphere, tmp_path, monkeypatch, capsys):
     """Issue 26 (1): ``igl-hhj demo`` and ``curvature --screenshot`` write the annotated
-    picture (title at the top, colour bar with range and unit below) as a palette PNG of
-    at most 256 colours."""
+    picture (title at the top, colour bar with range and unit below), as full-colour RGB
+    PNGs (a 256-colour palette banded smooth fields)."""
     from PIL import Image
     monkeypatch.chdir(tmp_path)
     path, _, _ = sphere
@@ -317,7 +317,7 @@ def test_screenshots_are_annotated_palette_pngs(sphere, tmp_path, monkeypatch, c
     assert code == 0
     for png in ("c.png", "igl_hhj_demo.png"):
         im = Image.open(png)
-        assert im.mode == "P" and len(im.getcolors(256) or ()) <= 256, png
+        assert im.mode == "RGB", png
         rgb = np.asarray(im.convert("RGB"), dtype=float) / 255
         text = (rgb.max(axis=2) < 0.35) & (np.ptp(rgb, axis=2) < 0.05)     # dark grey: text, not the mesh
         h = len(rgb)
@@ -485,9 +485,10 @@ def test_info_accepted_and_unrepairable_repair_rows(sphere, tmp_path, capsys):
     path, _, _ = sphere
     assert info(path, capsys)[1]["drop-in repairs"] == "none needed"
     V, F = DEGENERATE
-    path = write_off(tmp_path / "tiny.off", V * 1e-62, F)       # repaired, but still too small
+    path = write_off(tmp_path / "tiny.off", V * 1e-62, F)       # too small comes first: no repair
     code, rows, _ = info(path, capsys)
-    assert code == 1 and "the repaired mesh is still refused: the mesh is too small" in rows["drop-in repairs"]
+    assert code == 1 and rows["drop-in repairs"] == "none possible (the drop-in refuses it too)"
+    assert rows["verdict"].startswith("rejected: the mesh is too small")
     path = write_off(tmp_path / "tiny2.off", FLIPPED[0] * 1e-62, FLIPPED[1])   # refused before
     assert info(path, capsys)[1]["drop-in repairs"] == "none possible (the drop-in refuses it too)"
 
@@ -576,10 +577,11 @@ def test_directory_and_unreadable_file(tmp_path, capsys):
 @pytest.mark.parametrize("mesh, match", [(NONMANIFOLD, "non-manifold"), (DEGENERATE, "degenerate"),
                                          (FLIPPED, "not consistently oriented")])
 def test_curvature_bad_mesh_is_one_line(tmp_path, capsys, mesh, match):
+    """--strict refuses what the drop-in repairs (without it: tests/app/test_cli_parity.py)."""
     path = write_off(tmp_path / "bad.off", *mesh)
-    assert cli.main(["curvature", str(path)]) == 2
+    assert cli.main(["curvature", str(path), "--strict"]) == 2
     line = one_error_line(capsys.readouterr().err)
-    assert match in line and "igl-hhj info" in line
+    assert match in line and "igl-hhj info" in line and "--strict" in line
 
 
 def test_usage_errors_are_one_line(capsys):

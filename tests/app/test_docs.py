@@ -161,3 +161,77 @@ def test_results_moved_not_deleted():
         text = page_text(page)
         for row in rows:
             assert row in text, (page, row)
+
+
+#: pages whose ```python blocks run in a test of their own (the README in test_readme.py)
+PYTHON_BLOCK_TESTS = {"README.md": "test_readme_python_runs_as_written",
+                      "tutorial.md": "test_tutorial_python_runs_as_written",
+                      "papers.md": "test_page_python_runs_as_written",
+                      "batch.md": "test_page_python_runs_as_written",
+                      "features.md": "test_features_python_runs_as_written"}
+#: ```bash / ```text blocks are not run here: the README's set-up commands need the network
+#: (pip install; CI runs them: .ci/run), cli.md's block is --help output (checked against the
+#: parser in test_readme.py), batch.md's and contributing.md's commands start clusters or CI.
+
+
+def test_every_python_block_is_run():
+    """A page with a ```python block is run by a test (a new page cannot slip through)."""
+    pages = {p.name: p.read_text(encoding="utf-8") for p in [ROOT / "README.md", *PAGES]}
+    with_code = {name for name, text in pages.items() if python_blocks(text)}
+    assert with_code == set(PYTHON_BLOCK_TESTS), with_code ^ set(PYTHON_BLOCK_TESTS)
+    here = (Path(__file__).read_text(), (Path(__file__).parent / "test_readme.py").read_text())
+    for test in PYTHON_BLOCK_TESTS.values():
+        assert any(f"def {test}(" in t for t in here), test
+
+
+@pytest.mark.slow
+def test_features_python_runs_as_written(tmp_path):
+    run_blocks(python_blocks(page_text("features.md")), tmp_path, "features.md")
+
+
+INLINE_CALL = re.compile(r"`(igl_hhj\.[\w.]+\([^`]*\))`")
+
+
+def test_inline_calls_run_as_written():
+    """The one-call examples in the text (``igl_hhj.curvature_of(mesh, kind="mean")``) run on
+    the names they use: V, F, a TriangleMesh ``mesh`` / ``tm`` and an estimate ``est``; a call
+    with any other name (a file, hs/errors of a convergence study) is listed as skipped."""
+    import igl_hhj
+    from igl_hhj import baselines
+    from igl_hhj.surfaces import icosphere
+    V, F = icosphere(2)
+    namespace = dict(igl_hhj=igl_hhj, V=V, F=F, mesh=igl_hhj.TriangleMesh(V, F), tm=igl_hhj.TriangleMesh(V, F),
+                     est=baselines.hhj_vertex(V, F))
+    ran, skipped = [], []
+    for path in [ROOT / "README.md", *PAGES]:
+        for call in INLINE_CALL.findall(path.read_text(encoding="utf-8")):
+            names = set(re.findall(r"(?<![\w.\"'=])([A-Za-z_]\w*)(?=\s*[,)])", call.split("(", 1)[1]))
+            if not names <= set(namespace):
+                skipped.append((path.name, call))
+                continue
+            if "pyvista" in call and not _has("pyvista"):        # the optional package
+                skipped.append((path.name, call))
+                continue
+            eval(call, dict(namespace))                       # noqa: S307 - our own docs
+            ran.append(call)
+    assert 'igl_hhj.curvature_of(mesh, kind="mean")' in ran, (ran, skipped)
+    assert {call for _, call in skipped} <= {
+        'igl_hhj.convergence.plot_convergence(hs, errors, labels, rates=(1, 2), path="conv.png")'}, skipped
+
+
+def _has(module):
+    import importlib.util
+    return importlib.util.find_spec(module) is not None
+
+
+@pytest.mark.slow
+def test_api_page_shows_one_signature_and_code_wraps(html):
+    """curvature_of opened the API page with its overload signatures (4, then 2): one now;
+    the code blocks wrap long lines instead of running off the right edge (tutorial)."""
+    api = (html / "api.html").read_text()
+    assert api.count('id="igl_hhj.curvature_of"') == 1
+    block = api.split('id="igl_hhj.curvature_of"', 1)[1].split("</dt>", 1)[1].split("<dd>", 1)[0]
+    assert 'class="sig' not in block, "a second signature follows the first"
+    tutorial = (html / "tutorial.html").read_text()
+    assert "custom.css" in tutorial
+    assert "white-space: pre-wrap" in (html / "_static" / "custom.css").read_text()

@@ -104,6 +104,7 @@ reveal_type(igl_hhj.convergence.eoc([1.0, 0.5], [0.2, 0.1]))
 PD1, PD2, PV1, PV2, bad = igl_hhj.principal_curvature(V, F)
 reveal_type(PV1)
 reveal_type(bad)
+igl_hhj.curvature_of(igl_hhj.TriangleMesh(V, F), "mean")   # README's old mistake: "mean" is not F
 igl_hhj.principal_curvature(V, F, radius="5")   # a user's mistake mypy must catch
 '''
 
@@ -145,8 +146,10 @@ def test_user_script_sees_the_real_types(tmp_path):
     revealed = {lines[n - 1].split("reveal_type(", 1)[1][:-1]: t for n, t in _revealed(res.stdout).items()}
     assert "py.typed" not in res.stdout and "import-untyped" not in res.stdout, res.stdout
     errors = [ln for ln in res.stdout.splitlines() if ": error:" in ln]
-    # exactly one error: radius="5" (arg-type), on the last line
-    assert len(errors) == 1 and f":{len(lines)}:" in errors[0] and "arg-type" in errors[0], res.stdout
+    # exactly two errors: "mean" as F and radius="5" (arg-type), on the last two lines
+    assert len(errors) == 2, res.stdout
+    assert f":{len(lines) - 1}:" in errors[0] and "curvature_of" in errors[0], res.stdout
+    assert f":{len(lines)}:" in errors[1] and "arg-type" in errors[1], res.stdout
     assert len(revealed) == USER_SCRIPT.count("reveal_type("), res.stdout
     assert not [k for k, t in revealed.items() if t == "Any"], revealed
 

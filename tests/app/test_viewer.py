@@ -117,7 +117,7 @@ def test_register_comparison_shares_ranges(mock, ellipsoid):
     reg = viewer.register_comparison(V, F, name="cmp", enabled="K")
     assert set(reg.structures) == {"cmp HHJ", "cmp libigl"}
     for q, lab in zip(viewer.QUANTITIES, CURV):
-        a = reg.quantities[("cmp HHJ", f"{lab} (HHJ faces)")]
+        a = reg.quantities[("cmp HHJ", f"{lab} (HHJ vertices)")]     # like with like: the default
         b = reg.quantities[("cmp libigl", f"{lab} (libigl vertices)")]
         assert a.vminmax == b.vminmax == reg.ranges[q]
         assert reg.ranges[q] == viewer.color_range(a.values, b.values, robust=1.0)   # the default
@@ -286,9 +286,8 @@ def test_no_picture_without_a_renderer(mock, sphere):
 
 
 def test_to_image_is_the_screenshot(egl, sphere, tmp_path):
-    """to_image returns the picture screenshot writes before its palette reduction: (H, W, 4)
-    uint8, opaque, the PNG's pixels within the palette's rounding (mean ≤ 2 levels, no pixel's
-    colour off by more than the palette's worst cell); with and without titles / colour bars;
+    """to_image returns the picture screenshot writes: (H, W, 4) uint8, opaque, the PNG's
+    pixels exactly (full colour, no palette); with and without titles / colour bars;
     reg.screenshot is left alone."""
     V, F = sphere
     reg = viewer.register_curvature(V, F, name="s", per="face")
@@ -296,8 +295,7 @@ def test_to_image_is_the_screenshot(egl, sphere, tmp_path):
         im = viewer.to_image(reg, size=(320, 240), annotate=annotate)
         assert im.shape == (240, 320, 4) and im.dtype == np.uint8 and (im[..., 3] == 255).all()
         viewer.screenshot(tmp_path / f"s{annotate}.png", reg, size=(320, 240), annotate=annotate)
-        diff = np.abs(im[..., :3].astype(int) - _decode_png(tmp_path / f"s{annotate}.png")[..., :3].astype(int))
-        assert diff.mean() <= 2.0 and np.percentile(diff, 99.9) <= 40
+        np.testing.assert_array_equal(im[..., :3], _decode_png(tmp_path / f"s{annotate}.png")[..., :3])
     assert reg.screenshot == str(tmp_path / "sFalse.png")
     viewer.to_image(reg, size=(64, 64))
     assert reg.screenshot == str(tmp_path / "sFalse.png")
@@ -405,7 +403,7 @@ def test_registration_repr_is_short(mock, ellipsoid):
     reg = viewer.register_comparison(*ellipsoid, name="r")
     text = repr(reg)
     assert len(text) < 400 and "array" not in text
-    assert "'r HHJ'" in text and "mean H (HHJ faces)" in text
+    assert "'r HHJ'" in text and "mean H (HHJ vertices)" in text
 
 
 # --------------------------------------------------------------------------- views, titles, colour bars (issue 14)
@@ -442,7 +440,7 @@ def test_best_view_is_the_largest_projected_area(ellipsoid):
 def test_titles_and_turned_copies(mock, ellipsoid):
     V, F = ellipsoid
     plain = viewer.register_comparison(V, F, name="cmp")
-    assert plain.titles == {"cmp HHJ": f"HHJ, per face — cmp, {len(F):,} faces",
+    assert plain.titles == {"cmp HHJ": f"HHJ, per vertex — cmp, {len(F):,} faces",
                             "cmp libigl": f"libigl quadric fit, per vertex — cmp, {len(F):,} faces"}
     assert viewer.register_curvature(V, F, name="c", title="").titles == {}
     turned = viewer.register_comparison(V, F, name="cmp", view="+x")
@@ -495,3 +493,17 @@ def test_register_curvature_defaults_to_the_robust_range(sphere):
     cmp = viewer.register_comparison(V, F, name="cmp")
     assert cmp.ranges["H"][1] < 10
     ps.remove_all_structures()
+
+
+def test_png_is_full_colour(tmp_path):
+    """A smooth field keeps every level (the 256-colour palette banded the biharmonic demo):
+    a 2-D ramp of 4096 colours round-trips exactly."""
+    from PIL import Image
+
+    from igl_hhj.viewer.render import save_png
+    i, j = np.meshgrid(np.arange(64), np.arange(64), indexing="ij")
+    img = np.stack([4 * i, 4 * j, (i + j) % 256], axis=-1).astype(np.uint8)
+    assert save_png(tmp_path / "ramp.png", img)
+    back = np.asarray(Image.open(tmp_path / "ramp.png"))
+    assert back.shape == (64, 64, 3)
+    np.testing.assert_array_equal(back, img)

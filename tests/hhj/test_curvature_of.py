@@ -15,6 +15,8 @@ import igl_hhj
 from igl_hhj.curvature import CURVATURE_KIND_ALIASES, CURVATURE_KINDS
 from igl_hhj.surfaces.exact import Ellipsoid
 from igl_hhj.surfaces.meshing import ellipsoid_coarse, jitter_tangentially, refine
+from igl_hhj.mesh import TriangleMesh
+from igl_hhj.surfaces import icosphere
 
 
 @pytest.fixture(scope="module")
@@ -51,7 +53,7 @@ def test_values_are_the_underlying_functions(mesh, reference, per):
     for kind in CURVATURE_KINDS:
         _equal(igl_hhj.curvature_of(V, F, kind=kind, per=per), reference[per][kind])
     for alias, canonical in CURVATURE_KIND_ALIASES.items():
-        _equal(igl_hhj.curvature_of(V, F, alias, per), reference[per][canonical])
+        _equal(igl_hhj.curvature_of(V, F, kind=alias, per=per), reference[per][canonical])
     _equal(igl_hhj.curvature_of(V, F), reference["vertex"]["mean"])          # defaults: mean per vertex
     n = len(V) if per == "vertex" else len(F)
     assert reference[per]["mean"].shape == (n,) and reference[per]["directions"][0].shape == (n, 3)
@@ -66,13 +68,13 @@ def test_face_values_agree_with_the_principal_values(reference):
 
 def test_keyword_arguments_reach_the_underlying_functions(mesh):
     V, F = mesh
-    np.testing.assert_array_equal(igl_hhj.curvature_of(V, F, "k1", radius=2),
+    np.testing.assert_array_equal(igl_hhj.curvature_of(V, F, kind="k1", radius=2),
                                   igl_hhj.principal_curvature(V, F, radius=2)[2])
     _, _, PV1, PV2 = igl_hhj.face_principal_curvature(V, F, smoothing=1)
-    np.testing.assert_array_equal(igl_hhj.curvature_of(V, F, "mean", "face", smoothing=1), 0.5 * (PV1 + PV2))
-    np.testing.assert_array_equal(igl_hhj.curvature_of(V, F, "k2", "face", smoothing=1), PV2)
+    np.testing.assert_array_equal(igl_hhj.curvature_of(V, F, kind="mean", per="face", smoothing=1), 0.5 * (PV1 + PV2))
+    np.testing.assert_array_equal(igl_hhj.curvature_of(V, F, kind="k2", per="face", smoothing=1), PV2)
     with pytest.raises(TypeError, match="smoothing"):
-        igl_hhj.curvature_of(V, F, "mean", per="vertex", smoothing=1)
+        igl_hhj.curvature_of(V, F, kind="mean", per="vertex", smoothing=1)
 
 
 @pytest.mark.parametrize("bad", ["curv", "Mean", "gauss_curvature", "", None, 1])
@@ -128,3 +130,15 @@ def test_meshio_object(mesh, reference):
 def test_triangle_mesh_object(mesh, reference):
     V, F = mesh
     _check_object(igl_hhj.TriangleMesh(V, F), reference)
+
+
+def test_quantity_is_keyword_only():
+    """README's ``curvature_of(mesh, "mean")`` put "mean" into F: a TypeError naming the fix at
+    run time, and positional quantities are refused (mypy rejects both: tests/app/test_typing.py)."""
+    V, F = icosphere(1)
+    mesh = TriangleMesh(V, F)
+    with pytest.raises(TypeError, match="keyword-only: curvature_of\\(mesh, kind='mean'\\)"):
+        igl_hhj.curvature_of(mesh, "mean")
+    with pytest.raises(TypeError, match="positional"):
+        igl_hhj.curvature_of(V, F, "mean")                     # type: ignore[misc]
+    np.testing.assert_array_equal(igl_hhj.curvature_of(mesh, kind="mean"), igl_hhj.curvature_of(V, F))

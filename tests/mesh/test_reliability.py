@@ -123,8 +123,11 @@ def test_hhj_auto_on_large_mesh_with_thin_face(large_grid):
 def test_cli_thin_face_is_one_line_and_info_agrees(tmp_path, capsys):
     V, F = wavy_grid(20)
     path = write_off(tmp_path / "thin.off", thin_face(V, F, 401, 1e-9), F)
-    assert cli.main(["curvature", str(path)]) == cli.EXIT_USAGE
+    assert cli.main(["curvature", str(path), "--strict"]) == cli.EXIT_USAGE
     assert "near-degenerate" in one_error_line(capsys.readouterr().err)
+    assert cli.main(["curvature", str(path)]) == 0           # repaired, as by the drop-in: one warning
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("igl-hhj: warning: ") and "sliver" in err[0]
     assert cli.main(["info", str(path)]) == cli.EXIT_REJECTED
     assert "rejected: F has near-degenerate" in capsys.readouterr().out
 

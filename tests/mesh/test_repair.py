@@ -266,7 +266,7 @@ def test_repair_mesh_maps_and_summary():
     V, F, verts = fin(V2, F2)
     F = np.vstack([F, F[:2, ::-1], [[0, 0, 1]]])
     R = rp.repair_mesh(V, F)
-    assert R.summary == {"repeated corner": 1, "degenerate": 0, "duplicate": 2, "flipped": 0,
+    assert R.summary == {"repeated corner": 1, "degenerate": 0, "duplicate": 2, "two-sided": 0, "flipped": 0,
                          "non-orientable": 0, "non-manifold": 2}
     assert R.F.dtype == np.int64 and R.V.dtype == np.float64
     np.testing.assert_array_equal(R.V, V[R.vertex_map])

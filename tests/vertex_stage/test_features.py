@@ -545,3 +545,18 @@ def test_crease_cut_refuses_a_joined_edge_without_two_faces():
         kernels.crease_cut(mesh, join)
     with pytest.raises(ValueError, match="join"):
         kernels.crease_cut(mesh, join[:-1])
+
+
+def test_empty_and_unsigned_crease_edges():
+    """``crease_edges=[]`` is no pair, as ``np.zeros((0, 2))`` (it was refused for its shape);
+    uint64 indices beyond int64 are reported as given, not wrapped to negative numbers."""
+    import igl_hhj
+    from igl_hhj.surfaces import icosphere
+    V, F = icosphere(1)
+    a = igl_hhj.principal_curvature(V, F, crease_edges=[])
+    b = igl_hhj.principal_curvature(V, F, crease_edges=np.zeros((0, 2), dtype=np.int64))
+    for x, y in zip(a[:4], b[:4]):
+        np.testing.assert_array_equal(x, y)
+    for big in (2**64 - 1, 2**63 + 5):
+        with pytest.raises(ValueError, match=rf"row 0 \(0, {big}\) is not an edge.*out of range"):
+            igl_hhj.principal_curvature(V, F, crease_edges=np.array([[0, big]], dtype=np.uint64))
