@@ -272,16 +272,48 @@ def read_polygon_mesh(path: str | os.PathLike, readers: tuple[str, ...] | None =
         raise ValueError(f"unknown reader {chosen!r} (use trimesh, pyvista or meshio)")
     _import(chosen, path)                 # imported here: the child process only parses
     if chosen == "pyvista":
-        _import("vtkmodules.util.numpy_support", path)
+        _warm_pyvista(path)
     return _in_child_process(read, path, chosen)
 
 
 # ----------------------------------------------------------------------------- isolation
+ISOLATE_READERS = True
+"""Parse with the third-party packages in a forked child process (:func:`_in_child_process`).
+Costs about one ``fork`` per file (measured in igl_hhj/docs/io.md); False parses in this
+process, where a hostile file can crash it."""
+
 READER_MEMORY = (8, 1 << 30)
 """``(a, b)``: a child process parsing a file of ``s`` bytes may grow its address space by
 ``a * s + b`` bytes (an ascii file's numbers take up to 4x its bytes as float64; VTK and
 the Python wrappers reserve a few hundred MB).  A file declaring more than that is refused
 with a :class:`MeshFileError` instead of exhausting the machine's memory."""
+
+
+_VTK_MODULES = ("vtkmodules.util.numpy_support", "vtkmodules.vtkIOXML", "vtkmodules.vtkIOXMLParser",
+                "vtkmodules.vtkIOLegacy", "vtkmodules.vtkIOCore", "vtkmodules.vtkIOPLY")
+"""Modules pyvista imports lazily on its first read."""
+
+_warmed: set = set()
+
+
+def _warm_pyvista(path):
+    """Once per process, before the first fork: import what pyvista imports lazily and let it
+    scan its reader plug-ins (``importlib.metadata`` entry points, ~60 ms) by reading a
+    one-triangle file written here, so that the forked children, which lose whatever they
+    initialise, do not pay that on every file."""
+    if "pyvista" in _warmed:
+        return
+    for module in _VTK_MODULES:
+        _import(module, path)
+    import tempfile
+    from .vtk_files import write_vtk
+    pv = _import("pyvista", path)
+    with tempfile.TemporaryDirectory(prefix="igl_hhj_warm_") as tmp:
+        tiny = os.path.join(tmp, "tiny.vtp")
+        write_vtk(tiny, np.eye(3), np.array([[0, 1, 2]]))
+        with CapturedOutput():
+            pv.read(tiny)
+    _warmed.add("pyvista")
 
 
 def _vm_size():
@@ -340,7 +372,7 @@ def _in_child_process(read, path, reader):
     import pickle
     import signal
     import warnings
-    if not hasattr(os, "fork"):
+    if not ISOLATE_READERS or not hasattr(os, "fork"):
         return read(path)
     size = path.stat().st_size
     r, w = os.pipe()
