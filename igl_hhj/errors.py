@@ -32,6 +32,7 @@ OPTIONAL_PACKAGES = {
     "trimesh": ("trimesh", "io"),
     "pyvista": ("pyvista", "io"),
     "lxml": ("lxml", "io"),
+    "networkx": ("networkx", "io"),
     "tqdm": ("tqdm", "benchmark"),
     "pymeshlab": ("pymeshlab", "benchmark"),
 }

@@ -201,9 +201,36 @@ def _import(package, path):
                                   f"{install_hint(missing)}", name=missing) from None
 
 
-def _error(path, exc):
-    text = " ".join(str(exc).split()) or type(exc).__name__
-    return MeshFileError(f"{path}: could not read it: {text[:200]}")
+_FORMATS = {".gltf": "glTF file", ".glb": "binary glTF (.glb) file", ".3mf": "3MF file",
+            ".vtp": "VTK XML PolyData (.vtp) file", ".vtu": "VTK XML UnstructuredGrid (.vtu) file",
+            ".vtk": "legacy VTK (.vtk) file", ".ply": "PLY file"}
+
+_KINDS = {AssertionError: "a consistency check of the reader failed",
+          IndexError: "an index or count points past the data the file holds",
+          KeyError: "a required entry is missing",
+          StopIteration: "the file ends before the data its header announces",
+          EOFError: "the file ends before the data its header announces",
+          UnicodeError: "text that is not valid UTF-8 / ASCII",
+          TypeError: "a value has the wrong type", AttributeError: "an element is missing or has the wrong kind",
+          OverflowError: "a count or size is too large", ZeroDivisionError: "a zero size or count"}
+
+
+def _error(path, exc, reader=None):
+    """A :class:`MeshFileError` naming the file, its format and the parser's complaint in words.
+
+    Parsers raise many kinds of exception, some with one word or none (``AssertionError``,
+    ``list index out of range``, ``StopIteration``): the message always says what kind of
+    problem it is, then the parser's own text when it has one."""
+    path = Path(path)
+    what = _FORMATS.get(path.suffix.lower(), f"{path.suffix} file")
+    text = " ".join(str(exc).split())
+    kind = next((v for k, v in _KINDS.items() if isinstance(exc, k)), None)
+    if kind is None:
+        kind = "the file is corrupt or not a valid " + what
+    by = f" ({reader})" if reader else ""
+    detail = f": {text[:200]}" if len(text.split()) > 3 else (f" ({type(exc).__name__}: {text[:100]})"
+                                                              if text else f" ({type(exc).__name__})")
+    return MeshFileError(f"{path}: could not read this {what}{by}: {kind}{detail}")
 
 
 def read_polygon_mesh(path: str | os.PathLike, readers: tuple[str, ...] | None = None) -> PolygonMesh:
@@ -240,13 +267,160 @@ def read_polygon_mesh(path: str | os.PathLike, readers: tuple[str, ...] | None =
             continue
         chosen = r
         break
-    if chosen == "trimesh":
-        return _read_trimesh(path)
+    read = {"trimesh": _read_trimesh, "pyvista": _read_pyvista, "meshio": _read_meshio}.get(chosen)
+    if read is None:
+        raise ValueError(f"unknown reader {chosen!r} (use trimesh, pyvista or meshio)")
+    _import(chosen, path)                 # imported here: the child process only parses
     if chosen == "pyvista":
-        return _read_pyvista(path)
-    if chosen == "meshio":
-        return _read_meshio(path)
-    raise ValueError(f"unknown reader {chosen!r} (use trimesh, pyvista or meshio)")
+        _warm_pyvista(path)
+    return _in_child_process(read, path, chosen)
+
+
+# ----------------------------------------------------------------------------- isolation
+ISOLATE_READERS = True
+"""Parse with the third-party packages in a forked child process (:func:`_in_child_process`).
+Costs about one ``fork`` per file (measured in igl_hhj/docs/io.md); False parses in this
+process, where a hostile file can crash it."""
+
+READER_MEMORY = (8, 1 << 30)
+"""``(a, b)``: a child process parsing a file of ``s`` bytes may grow its address space by
+``a * s + b`` bytes (an ascii file's numbers take up to 4x its bytes as float64; VTK and
+the Python wrappers reserve a few hundred MB).  A file declaring more than that is refused
+with a :class:`MeshFileError` instead of exhausting the machine's memory."""
+
+
+_VTK_MODULES = ("vtkmodules.util.numpy_support", "vtkmodules.vtkIOXML", "vtkmodules.vtkIOXMLParser",
+                "vtkmodules.vtkIOLegacy", "vtkmodules.vtkIOCore", "vtkmodules.vtkIOPLY")
+"""Modules pyvista imports lazily on its first read."""
+
+_warmed: set = set()
+
+
+def _warm_pyvista(path):
+    """Once per process, before the first fork: import what pyvista imports lazily and let it
+    scan its reader plug-ins (``importlib.metadata`` entry points, ~60 ms) by reading a
+    one-triangle file written here, so that the forked children, which lose whatever they
+    initialise, do not pay that on every file."""
+    if "pyvista" in _warmed:
+        return
+    for module in _VTK_MODULES:
+        _import(module, path)
+    import tempfile
+    from .vtk_files import write_vtk
+    pv = _import("pyvista", path)
+    with tempfile.TemporaryDirectory(prefix="igl_hhj_warm_") as tmp:
+        tiny = os.path.join(tmp, "tiny.vtp")
+        write_vtk(tiny, np.eye(3), np.array([[0, 1, 2]]))
+        with CapturedOutput():
+            pv.read(tiny)
+    _warmed.add("pyvista")
+
+
+def _vm_size():
+    """The address space of this process in bytes (Linux ``/proc``), or None."""
+    try:
+        with open("/proc/self/status", "rb") as fh:
+            for line in fh:
+                if line.startswith(b"VmSize:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return None
+
+
+def _limit_memory(size):
+    try:
+        import resource
+    except ImportError:                                    # not a POSIX system
+        return
+    vm = _vm_size()
+    if vm is None:
+        return
+    soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+    cap = vm + READER_MEMORY[0] * size + READER_MEMORY[1]
+    for limit in (soft, hard):
+        if limit != resource.RLIM_INFINITY:
+            cap = min(cap, limit)
+    resource.setrlimit(resource.RLIMIT_AS, (cap, hard))
+
+
+def _child_result(read, path):
+    """What the child sends back: ("ok", PolygonMesh) or (exception class name, message, name)."""
+    try:
+        return ("ok", read(path))
+    except MeshFileError as exc:
+        return ("MeshFileError", str(exc), None)
+    except ModuleNotFoundError as exc:
+        return ("ModuleNotFoundError", str(exc), exc.name)
+    except MemoryError:
+        return ("MeshFileError", f"{path}: could not read it: {_FORMATS.get(path.suffix.lower(), 'the file')} "
+                                 f"declares more data than fits in memory (the file is corrupt or "
+                                 f"its counts are larger than its contents)", None)
+    except Exception as exc:                                # a reader bug: still a sentence
+        return ("MeshFileError", str(_error(path, exc)), None)
+
+
+def _in_child_process(read, path, reader):
+    """``read(path)`` in a forked child process with a memory cap (:data:`READER_MEMORY`).
+
+    Third-party parsers (VTK above all) abort or segfault on hostile files and
+    allocate whatever a header declares; in a child, a crash or an exhausted memory
+    cap becomes a :class:`MeshFileError` naming the file, the format and what happened,
+    and this process is untouched.  The result comes back pickled through a pipe.
+    Without ``os.fork`` (Windows) the file is parsed in this process.
+    """
+    import pickle
+    import signal
+    import warnings
+    if not ISOLATE_READERS or not hasattr(os, "fork"):
+        return read(path)
+    size = path.stat().st_size
+    r, w = os.pipe()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)   # fork with threads (Python 3.12)
+        pid = os.fork()
+    if pid == 0:                                           # the child: parse, send, exit
+        code = 1
+        try:
+            os.close(r)
+            null = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(null, 1)                               # a crash's last words stay quiet
+            os.dup2(null, 2)
+            _limit_memory(size)
+            data = pickle.dumps(_child_result(read, path), protocol=pickle.HIGHEST_PROTOCOL)
+            with os.fdopen(w, "wb") as fh:
+                fh.write(data)
+            code = 0
+        finally:
+            os._exit(code)
+    os.close(w)
+    chunks = []
+    with os.fdopen(r, "rb") as fh:
+        while True:
+            block = fh.read(1 << 20)
+            if not block:
+                break
+            chunks.append(block)
+    _, status = os.waitpid(pid, 0)
+    what = _FORMATS.get(path.suffix.lower(), f"{path.suffix} file")
+    if os.WIFSIGNALED(status) or os.WEXITSTATUS(status) != 0 or not chunks:
+        if os.WIFSIGNALED(status):
+            sig = os.WTERMSIG(status)
+            try:
+                how = f"it crashed ({signal.Signals(sig).name})"
+            except ValueError:
+                how = f"it was killed by signal {sig}"
+        else:
+            how = "it stopped without an answer (out of memory?)"
+        raise MeshFileError(f"{path}: could not read it: {reader} failed on this {what}: {how}; "
+                            f"the file is corrupt, truncated or declares more data than it holds")
+    result = pickle.loads(b"".join(chunks))
+    if result[0] == "ok":
+        return result[1]
+    kind, message, name = result
+    if kind == "ModuleNotFoundError":
+        raise ModuleNotFoundError(message, name=name)
+    raise MeshFileError(message)
 
 
 def _triangles(F):
@@ -259,10 +433,12 @@ def _read_trimesh(path):
     try:
         with CapturedOutput():
             mesh = trimesh.load(str(path), force="mesh", process=False)
-    except ModuleNotFoundError as exc:                      # lxml for 3MF
-        raise _import(exc.name or "lxml", path) from None
+    except ModuleNotFoundError as exc:                      # lxml, networkx for 3MF
+        missing = (exc.name or "lxml").split(".")[0]
+        raise ModuleNotFoundError(f"{path}: reading {path.suffix} files needs {missing}: "
+                                  f"{install_hint(missing)}", name=missing) from None
     except Exception as exc:                               # trimesh raises many kinds
-        raise _error(path, exc) from None
+        raise _error(path, exc, "trimesh") from None
     V = np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), dtype=np.float64)
     F = np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), dtype=np.int64)
     I, C = _triangles(F)
@@ -293,10 +469,14 @@ def _read_pyvista(path):
             warnings.simplefilter("always")
             ds = pv.read(str(path))
     except Exception as exc:                               # VTK readers raise many kinds
-        raise _error(path, exc) from None
+        raise _error(path, exc, "pyvista") from None
     messages = [" ".join(str(w.message).split())[:200] for w in caught]
     if isinstance(ds, pv.MultiBlock):
         ds = ds.combine()
+    if not isinstance(ds, (pv.PolyData, pv.UnstructuredGrid)):
+        raise MeshFileError(f"{path}: holds a VTK {type(ds).__name__} (a grid of points or cells), not a "
+                            f"surface mesh of polygons: extract its surface first (e.g. pyvista's "
+                            f"extract_surface()) and save that")
     if isinstance(ds, pv.PolyData):
         polys = ds.GetPolys()
         I, C = _cell_array(vtk_to_numpy(polys.GetOffsetsArray()), vtk_to_numpy(polys.GetConnectivityArray()))
@@ -330,7 +510,7 @@ def _read_meshio(path):
         with CapturedOutput():
             m = meshio.read(str(path))
     except Exception as exc:                               # meshio raises many kinds
-        raise _error(path, exc) from None
+        raise _error(path, exc, "meshio") from None
     keep = [j for j, b in enumerate(m.cells) if b.type in ("triangle", "quad") or b.type.startswith("polygon")]
     dropped = {}
     for j, b in enumerate(m.cells):

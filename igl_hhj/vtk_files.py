@@ -37,7 +37,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-__all__ = ["VTK_EXTENSIONS", "write_vtk"]
+__all__ = ["VTK_EXTENSIONS", "write_vtk", "read_vtk", "NotWrittenHere"]
 
 VTK_EXTENSIONS = (".vtp", ".vtu", ".vtk")
 """Extensions :func:`write_vtk` writes."""
@@ -214,3 +214,205 @@ def write_vtk(path: str | os.PathLike, V: Any, F: Any, *, point_data: Mapping[st
         _write_legacy(path, V, F, pdata, cdata, scalars, " ".join(title.split()) or "igl_hhj")
     else:
         _write_xml(path, V, F, pdata, cdata, scalars, polydata=ext == ".vtp")
+
+
+# --------------------------------------------------------------------------- reading back
+class NotWrittenHere(ValueError):
+    """A VTK file in a layout :func:`write_vtk` does not write (compressed, appended, ascii,
+    other types): read it with pyvista or meshio instead."""
+
+
+def _base64_array(path, text, dtype, count):
+    """A ``format="binary"`` DataArray body: base64 of a UInt64 byte count, then the bytes."""
+    try:
+        raw = base64.b64decode("".join(text.split()), validate=True)
+    except ValueError:
+        raise ValueError(f"{path}: a DataArray is not valid base64") from None
+    if len(raw) < 8:
+        raise ValueError(f"{path}: a DataArray is shorter than its size header")
+    nbytes = int(np.frombuffer(raw[:8], dtype="<u8")[0])
+    dt = np.dtype(dtype)
+    if nbytes != len(raw) - 8 or nbytes != count * dt.itemsize:
+        raise ValueError(f"{path}: a DataArray holds {len(raw) - 8} bytes, its header says {nbytes}, "
+                         f"the counts of the file need {count * dt.itemsize}")
+    return np.frombuffer(raw, dtype=dt, offset=8, count=count).copy()
+
+
+_READ_TYPES = {"Float64": "<f8", "Int64": "<i8", "UInt8": "u1"}
+
+
+def _read_xml(path, polydata):
+    import xml.etree.ElementTree as ET
+    try:
+        root = ET.parse(path).getroot()
+    except ET.ParseError as exc:
+        raise ValueError(f"{path}: not well-formed XML ({exc})") from None
+    kind = "PolyData" if polydata else "UnstructuredGrid"
+    a = root.attrib
+    if (root.tag != "VTKFile" or a.get("type") != kind or a.get("header_type") != "UInt64"
+            or a.get("byte_order") != "LittleEndian" or "compressor" in a):
+        raise NotWrittenHere(path)
+    pieces = root.findall(f"{kind}/Piece")
+    if len(pieces) != 1:
+        raise NotWrittenHere(path)
+    piece = pieces[0]
+
+    def count(name):
+        try:
+            n = int(piece.get(name, "0"))
+        except ValueError:
+            raise ValueError(f"{path}: {name}={piece.get(name)!r} is not a count") from None
+        if n < 0:
+            raise ValueError(f"{path}: negative {name}")
+        return n
+
+    nV = count("NumberOfPoints")
+    if polydata:
+        if any(count(k) for k in ("NumberOfVerts", "NumberOfLines", "NumberOfStrips")):
+            raise NotWrittenHere(path)
+        nF = count("NumberOfPolys")
+    else:
+        nF = count("NumberOfCells")
+
+    def array(el, n):
+        if el is None or el.get("format") != "binary" or el.get("type") not in _READ_TYPES:
+            raise NotWrittenHere(path)
+        try:
+            k = int(el.get("NumberOfComponents", "1"))
+        except ValueError:
+            raise ValueError(f"{path}: NumberOfComponents is not a count") from None
+        if k < 1:
+            raise ValueError(f"{path}: NumberOfComponents {k}")
+        out = _base64_array(path, el.text or "", _READ_TYPES[el.get("type")], n * k)
+        return out.reshape(n, k) if k > 1 else out
+
+    V = array(piece.find("Points/DataArray"), nV)
+    V = V.reshape(nV, -1) if nV else np.zeros((0, 3))
+    cells = piece.find("Polys" if polydata else "Cells")
+    if cells is None:
+        raise NotWrittenHere(path)
+    named = {el.get("Name"): el for el in cells.findall("DataArray")}
+    conn = array(named.get("connectivity"), 3 * nF)
+    offsets = array(named.get("offsets"), nF)
+    if not np.array_equal(offsets, 3 * np.arange(1, nF + 1)):
+        raise NotWrittenHere(path)                            # polygons other than triangles
+    if not polydata and not (array(named.get("types"), nF) == _VTK_TRIANGLE).all():
+        raise NotWrittenHere(path)
+    data = []
+    for tag, n in (("PointData", nV), ("CellData", nF)):
+        el = piece.find(tag)
+        fields = {}
+        for da in (el.findall("DataArray") if el is not None else []):
+            fields[str(da.get("Name"))] = array(da, n)
+        data.append((fields, el.get("Scalars") if el is not None else None))
+    return V, conn.reshape(nF, 3), data
+
+
+def _read_legacy(path):
+    size = os.path.getsize(path)
+    with open(path, "rb") as fh:
+        def line():
+            text = fh.readline(300)
+            if not text:
+                raise ValueError(f"{path}: the file ends before its data")
+            return text.decode("ascii", "replace").split()
+
+        head = [fh.readline(300) for _ in range(4)]
+        if (not head[0].startswith(b"# vtk DataFile") or head[2].strip() != b"BINARY"
+                or head[3].split() != [b"DATASET", b"UNSTRUCTURED_GRID"]):
+            raise NotWrittenHere(path)
+
+        def block(dtype, n):
+            nbytes = n * np.dtype(dtype).itemsize
+            if n < 0 or nbytes > size - fh.tell():
+                raise ValueError(f"{path}: a section declares {n} values, more than the file holds")
+            out = np.frombuffer(fh.read(nbytes), dtype=dtype).copy()
+            fh.readline(2)                                   # the line break after the block
+            return out
+
+        def number(word):
+            try:
+                return int(word)
+            except ValueError:
+                raise ValueError(f"{path}: {word!r} is not a count") from None
+
+        w = line()
+        if w[:1] != ["POINTS"] or len(w) != 3 or w[2] != "double":
+            raise NotWrittenHere(path)
+        nV = number(w[1])
+        V = block(">f8", 3 * nV).reshape(nV, 3)
+        w = line()
+        if w[:1] != ["CELLS"] or len(w) != 3:
+            raise NotWrittenHere(path)
+        nF = number(w[1])
+        if number(w[2]) != 4 * nF:
+            raise NotWrittenHere(path)
+        cells = block(">i4", 4 * nF).reshape(nF, 4)
+        if nF and (cells[:, 0] != 3).any():
+            raise NotWrittenHere(path)
+        w = line()
+        if w[:1] != ["CELL_TYPES"] or number(w[1]) != nF or not (block(">i4", nF) == _VTK_TRIANGLE).all():
+            raise NotWrittenHere(path)
+        data = {"CELL_DATA": ({}, None), "POINT_DATA": ({}, None)}
+        where, n = None, 0
+        while True:
+            text = fh.readline(300)
+            if not text:
+                break
+            w = text.decode("ascii", "replace").split()
+            if not w:
+                continue
+            if w[0] in data and len(w) == 2:
+                where, n = w[0], number(w[1])
+                if n != (nF if where == "CELL_DATA" else nV):
+                    raise ValueError(f"{path}: {w[0]} {n} does not match the mesh")
+                continue
+            if where is None or len(w) < 3 or w[2] != "double":
+                raise NotWrittenHere(path)
+            fields, active = data[where]
+            if w[0] == "SCALARS":
+                k = number(w[3]) if len(w) > 3 else 1
+                if line() != ["LOOKUP_TABLE", "default"]:
+                    raise NotWrittenHere(path)
+                if active is None and k == 1:
+                    data[where] = (fields, w[1])
+            elif w[0] in ("VECTORS", "TENSORS"):
+                k = 3 if w[0] == "VECTORS" else 9
+            else:
+                raise NotWrittenHere(path)
+            if k < 1:
+                raise ValueError(f"{path}: {k} components")
+            a = block(">f8", n * k)
+            fields[w[1]] = a if k == 1 else a.reshape(n, k)
+    return V, cells[:, 1:], [data["POINT_DATA"], data["CELL_DATA"]]
+
+
+def read_vtk(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, list]:
+    """Read back a file :func:`write_vtk` wrote, with numpy alone (no VTK, pyvista or meshio).
+
+    Parameters
+    ----------
+    path : str or os.PathLike, ``.vtp``, ``.vtu`` or ``.vtk``
+
+    Returns
+    -------
+    V : (#V, 3) float64
+    F : (#F, 3) int64
+    data : [(point_data, active point scalars), (cell_data, active cell scalars)]
+        dicts name -> (n,) or (n, k) float64 / int64 arrays; the active names or None.
+
+    Raises
+    ------
+    NotWrittenHere
+        A layout :func:`write_vtk` does not write (read it with pyvista or meshio).
+    ValueError
+        A damaged file: counts that do not match the data, invalid base64 or XML.
+    """
+    ext = Path(path).suffix.lower()
+    if ext not in VTK_EXTENSIONS:
+        raise ValueError(f"{path}: not a VTK extension {Path(path).suffix!r} (use {', '.join(VTK_EXTENSIONS)})")
+    V, F, data = _read_legacy(path) if ext == ".vtk" else _read_xml(path, polydata=ext == ".vtp")
+    V = np.asarray(V, dtype=np.float64)
+    if V.ndim != 2 or V.shape[1] != 3:
+        raise ValueError(f"{path}: points are not 3D (shape {V.shape})")
+    return V, np.asarray(F, dtype=np.int64), data

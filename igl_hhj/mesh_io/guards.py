@@ -160,9 +160,72 @@ def _check_stl(path, head, size):
                             f"of 3: three per facet); truncated or corrupt")
 
 
+def _msh_binary_header(path):
+    """``(data_size)`` of a binary Gmsh 2 ``.msh`` (``$MeshFormat`` then ``2.2 1 8``), None for ascii."""
+    with open(path, "rb") as fh:
+        head = fh.read(256)
+    lines = head.split(b"\n")
+    if len(lines) < 3 or lines[0].strip() != b"$MeshFormat":
+        return None
+    words = lines[1].split()
+    if len(words) >= 3 and words[1] == b"1":
+        try:
+            return int(words[2])
+        except ValueError:
+            raise MeshFileError(f"{path}: corrupt $MeshFormat line {lines[1][:40]!r}: the data size "
+                                f"is not an integer") from None
+    return None
+
+
+def _check_msh_binary(path, size, data_size):
+    """A binary Gmsh 2 ``.msh``: the counts of ``$Nodes`` (each ``4 + 3 data_size`` bytes) and
+    ``$Elements`` (at least 8 bytes each) against the bytes that follow them.  Counting text
+    lines in a binary file is meaningless (its numbers contain newline bytes)."""
+    if data_size not in (4, 8):
+        raise MeshFileError(f"{path}: binary .msh with data size {data_size} (Gmsh writes 8)")
+    with open(path, "rb") as fh:
+        data_at = {}
+        for key, each in ((b"$Nodes", 4 + 3 * data_size), (b"$Elements", 8)):
+            fh.seek(0)
+            pos, tail = 0, b""
+            found = -1
+            while True:                                    # the keyword, in 4 MB blocks
+                block = fh.read(1 << 22)
+                if not block:
+                    break
+                hit = (tail + block).find(key + b"\n")
+                if hit >= 0:
+                    found = pos - len(tail) + hit
+                    break
+                tail = block[-16:]
+                pos += len(block)
+            if found < 0:
+                raise MeshFileError(f"{path}: binary .msh without a {key.decode()} section")
+            fh.seek(found + len(key) + 1)
+            line = fh.readline(40)
+            try:
+                n = int(line.split()[0])
+            except (IndexError, ValueError):
+                raise MeshFileError(f"{path}: {key.decode()} is not followed by its count "
+                                    f"({line[:20]!r})") from None
+            rest = size - fh.tell()
+            if n < 0 or n * each > rest:
+                raise MeshFileError(f"{path}: section {key.decode()} declares {n} records, which need "
+                                    f"at least {n * each} bytes, the file has {rest} more "
+                                    f"(truncated or corrupt)")
+            data_at[key] = n
+    return data_at
+
+
 def _check_keyword_counts(path, size):
     """.mesh / .msh: a count after a section keyword (``Vertices``, ``$Nodes``, ...) must
-    not exceed the lines that follow (libigl allocates what the count says)."""
+    not exceed the lines that follow (libigl allocates what the count says); a binary
+    ``.msh``: against the bytes that follow (:func:`_check_msh_binary`)."""
+    if path.suffix.lower() == ".msh":
+        data_size = _msh_binary_header(path)
+        if data_size is not None:
+            _check_msh_binary(path, size, data_size)
+            return
     L = _Lines(path, 0)
     letter = ((L.c0 | 32) >= ord("a")) & ((L.c0 | 32) <= ord("z")) | (L.c0 == ord("$"))
     kw = np.flatnonzero(letter & (L.first < 0) & (L.ntok <= 2))

@@ -11,7 +11,7 @@ from numpy.typing import NDArray
 
 from ..errors import MeshFileError
 from ..results import QUANTITIES, CurvatureEstimate
-from .extensions import RESULT_EXTENSIONS
+from .extensions import RESULT_EXTENSIONS, VTK_EXTENSIONS
 from .guards import _HEADER_BYTES, _check_input_file_any
 from .ply import _parse_ply_header, _ply_head, _ply_scalar
 from .readers import read_mesh_file
@@ -93,13 +93,68 @@ def _ply_values(path):
     return out, comments
 
 
+def _npz_arrays(p):
+    """Every array of an ``.npz`` archive; a damaged one (truncated, empty, not a zip, an
+    entry that is not an array) is a :class:`MeshFileError` saying so."""
+    import zipfile
+    import zlib
+    try:
+        with np.load(p, allow_pickle=False) as z:
+            return {k: z[k] for k in z.files}
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile, zlib.error,
+            NotImplementedError, UnicodeError) as exc:
+        text = " ".join(str(exc).split())[:150]
+        raise MeshFileError(f"{p}: not a readable .npz archive (truncated, empty or damaged: "
+                            f"{type(exc).__name__}{': ' + text if text else ''})") from None
+
+
+def _read_own_vtk(p):
+    """The arrays of a VTK file as :func:`igl_hhj.vtk_files.write_vtk` writes them (numpy only,
+    so the plain install re-opens its own outputs); None for another layout."""
+    from ..vtk_files import NotWrittenHere, read_vtk
+    _check_input_file_any(p)
+    try:
+        return read_vtk(p)
+    except NotWrittenHere:
+        return None
+    except (ValueError, OSError, EOFError) as exc:
+        raise MeshFileError(f"{p}: damaged VTK file: {' '.join(str(exc).split())[:200]}") from None
+
+
+def _real(p, name, a):
+    """``a`` as float64 if it holds real numbers, else a MeshFileError naming it."""
+    a = np.asarray(a)
+    if a.dtype.kind not in "fiub":
+        raise MeshFileError(f"{p}: " * bool(p) + f"array {name} holds {a.dtype} values, not real numbers")
+    return a.astype(np.float64)
+
+
+def _checked_mesh(p, V, F):
+    """V (#V, 3) real and finite, F (#F, 3) integer indices into V: else a MeshFileError."""
+    V, F = np.asarray(V), np.asarray(F)
+    V = _real(p, "V", V)
+    if V.ndim != 2 or V.shape[1] != 3 or not len(V):
+        raise MeshFileError(f"{p}: V must be (#V, 3) points, it has shape {V.shape}")
+    if not np.isfinite(V).all():
+        raise MeshFileError(f"{p}: V holds {int((~np.isfinite(V)).any(axis=1).sum())} points that are not finite")
+    if F.dtype.kind not in "iu" and not (F.dtype.kind == "f" and np.isfinite(F).all()
+                                         and (F == np.round(F)).all()):
+        raise MeshFileError(f"{p}: F must hold integer vertex indices, it holds {F.dtype} values")
+    if F.ndim != 2 or F.shape[1] != 3 or not len(F):
+        raise MeshFileError(f"{p}: F must be (#F, 3) triangles, it has shape {F.shape}")
+    if F.min() < 0 or F.max() >= len(V):
+        raise MeshFileError(f"{p}: F refers to vertex {int(F.min()) if F.min() < 0 else int(F.max())}, "
+                            f"the file has vertices 0 .. {len(V) - 1}")
+    return V, F.astype(np.int64)
+
+
 def _estimate_from(fields, location, method):
     have = [q for q in QUANTITIES if q in fields]
     if len(have) < len(QUANTITIES):
         raise MeshFileError(f"no curvature arrays {', '.join(q for q in QUANTITIES if q not in have)} per "
                             f"{location} (it holds: {', '.join(sorted(fields)) or 'nothing'}); "
                             f"write one with 'igl-hhj curvature MESH -o OUT'")
-    vals = {q: np.asarray(fields[q], dtype=np.float64).reshape(-1) for q in QUANTITIES}
+    vals = {q: _real("", q, fields[q]).reshape(-1) for q in QUANTITIES}
     if all(f"{k}{c}" in fields for k in ("d1", "d2") for c in "xyz"):          # PLY columns d1x ...
         d = [np.column_stack([fields[f"{k}{c}"] for c in "xyz"]) for k in ("d1", "d2")]
     else:
@@ -144,17 +199,21 @@ def read_curvature(path: str | os.PathLike) -> CurvatureFile:
     try:
         if ext == ".npz":
             _check_input_file_any(p)
-            try:
-                z = np.load(p, allow_pickle=False)
-                fields = {k: z[k] for k in z.files}
-            except (OSError, ValueError) as exc:
-                raise MeshFileError(f"{p}: not an .npz archive: {exc}") from None
+            fields = _npz_arrays(p)
             V, F = fields.pop("V", None), fields.pop("F", None)
             if V is None or F is None:
                 raise MeshFileError(f"{p}: no arrays V and F (it holds: {', '.join(sorted(fields))})")
             location = str(fields.pop("per", "vertex"))
+            if location not in ("vertex", "face"):
+                raise MeshFileError(f"{p}: per = {location[:30]!r}, expected 'vertex' or 'face'")
             method = str(fields.pop("method", ""))
             S = fields.pop("S", None)
+        elif ext in VTK_EXTENSIONS and (ours := _read_own_vtk(p)) is not None:
+            V, F, ((pdata, pscalars), (cdata, cscalars)) = ours
+            quantity = pscalars or cscalars or "H"
+            S = cdata.get("S")
+            location = "vertex" if "H" in pdata else "face"
+            fields = pdata if location == "vertex" else cdata
         else:
             mf = read_mesh_file(p)
             V, F = mf.V, mf.F
@@ -176,13 +235,15 @@ def read_curvature(path: str | os.PathLike) -> CurvatureFile:
     except MeshFileError as exc:
         msg = str(exc)
         raise MeshFileError(msg if msg.startswith(str(p)) else f"{p}: {msg}") from None
-    V = np.asarray(V, dtype=np.float64)
-    F = np.asarray(F, dtype=np.int64)
+    V, F = _checked_mesh(p, V, F)
     n = len(V) if est.location == "vertex" else len(F)
     if len(est.k1) != n:
         raise MeshFileError(f"{p}: {len(est.k1)} values per {est.location}, the mesh has {n} {est.location}s")
     if S is not None:
-        S = np.asarray(S, dtype=np.float64).reshape(-1, 3, 3)
+        S = _real(p, "S", S)
+        if S.size != 9 * len(F):
+            raise MeshFileError(f"{p}: the shape operator S has {S.size} values, 9 per face need {9 * len(F)}")
+        S = S.reshape(-1, 3, 3)
     if method.startswith("hhj"):
         method = "hhj"
     elif method.startswith("libigl"):

@@ -65,7 +65,17 @@ class _Lines:
                 if block:
                     cut = data.rfind(b"\n") + 1
                     if cut == 0:
-                        carry = data
+                        if len(data) <= _CHUNK:
+                            carry = data
+                            continue
+                        summary, carry, length = self._long_line(fh, data, comments, corners)
+                        if summary is not None:            # one line, streamed
+                            for k, v in summary.items():
+                                parts[k].append(v)
+                            parts["lineno"][-1] += line0
+                            parts["offset"][-1] += pos0
+                        line0 += 1
+                        pos0 += length
                         continue
                     data, carry = data[:cut], data[cut:]
                 if data:
@@ -79,6 +89,60 @@ class _Lines:
                     break
         for k, v in parts.items():
             setattr(self, k, np.concatenate(v) if v else np.zeros(0, dtype=np.int64))
+
+    _LONG_HEAD = 1 << 16
+    """Bytes of an over-long line whose tokens are classified (the rest are only counted)."""
+
+    def _long_line(self, fh, data, comments, corners):
+        """Summarise a line longer than ``_CHUNK`` bytes (``data`` is its start, without a line
+        break) by streaming it: memory O(``_CHUNK``) whatever its length (a valid file followed
+        by a long tail of NUL bytes, an interrupted copy, must not cost 13x its size).
+
+        Its first ``_LONG_HEAD`` bytes (cut at a space) are classified as usual; later tokens
+        are counted but never as numbers or indices, so a check that needs them refuses the
+        line (by name) rather than trusting it, and a line no check reads costs nothing.
+        Returns ``(summary or None, the bytes after the line break, bytes of the line with its
+        break)``."""
+        head = data[:self._LONG_HEAD]
+        sp = max(head.rfind(c) for c in (b" ", b"\t", b"\r", b"\v", b"\f"))
+        head = head[:sp] if sp > 0 else head
+        summary = self._scan(head + b"\n", comments, corners) if head.strip() else None
+        if summary is not None and not len(summary["ntok"]):
+            summary = None
+        counted = len(head)
+        ntok = int(summary["ntok"][0]) if summary is not None else 0
+        prev_space = True
+        in_comment = comments and b"#" in head
+        length = counted
+        rest = data[counted:]
+        while True:
+            nl = rest.find(b"\n")
+            piece = rest if nl < 0 else rest[:nl]
+            if not in_comment and piece:
+                if comments and b"#" in piece:
+                    piece = piece[:piece.find(b"#")]
+                    in_comment = True
+                buf = np.frombuffer(piece, dtype=np.uint8)
+                if buf.size:
+                    space = _WS[buf]
+                    starts = int(np.count_nonzero(~space[1:] & space[:-1])) + int(prev_space and not space[0])
+                    ntok += starts
+                    prev_space = bool(space[-1])
+            length += len(rest) if nl < 0 else nl + 1
+            if nl >= 0:
+                after = rest[nl + 1:]
+                break
+            rest = fh.read(_CHUNK)
+            if not rest:
+                after = b""
+                break
+        if summary is None:
+            if ntok == 0:
+                return None, after, length
+            summary = self._scan(b"\x00\n", comments, corners)     # a line of one non-number token
+        summary["ntok"] = np.array([ntok], dtype=np.int64)
+        summary["maxlen"] = np.array([length], dtype=np.int64)
+        return summary, after, length
 
     def __len__(self):
         return len(self.ntok)
