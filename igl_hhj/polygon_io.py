@@ -289,6 +289,17 @@ the Python wrappers reserve a few hundred MB).  A file declaring more than that 
 with a :class:`MeshFileError` instead of exhausting the machine's memory."""
 
 
+READER_SECONDS = (60, 10 << 20)
+"""``(t, r)``: a child process parsing a file of ``s`` bytes is killed after ``t + s / r``
+seconds (60 s, plus one per 10 MB): a parser that loops on a hostile file, or a child
+that deadlocks after ``fork`` in a process with threads, becomes a :class:`MeshFileError`
+instead of a hang of the caller."""
+
+
+def _reader_seconds(size):
+    return int(READER_SECONDS[0] + -(-size // READER_SECONDS[1]))
+
+
 _VTK_MODULES = ("vtkmodules.util.numpy_support", "vtkmodules.vtkIOXML", "vtkmodules.vtkIOXMLParser",
                 "vtkmodules.vtkIOLegacy", "vtkmodules.vtkIOCore", "vtkmodules.vtkIOPLY")
 """Modules pyvista imports lazily on its first read."""
@@ -375,6 +386,7 @@ def _in_child_process(read, path, reader):
     if not ISOLATE_READERS or not hasattr(os, "fork"):
         return read(path)
     size = path.stat().st_size
+    seconds = _reader_seconds(size)
     r, w = os.pipe()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DeprecationWarning)   # fork with threads (Python 3.12)
@@ -387,6 +399,8 @@ def _in_child_process(read, path, reader):
             os.dup2(null, 1)                               # a crash's last words stay quiet
             os.dup2(null, 2)
             _limit_memory(size)
+            signal.signal(signal.SIGALRM, signal.SIG_DFL)  # the alarm kills, whatever the parser does
+            signal.alarm(seconds)
             data = pickle.dumps(_child_result(read, path), protocol=pickle.HIGHEST_PROTOCOL)
             with os.fdopen(w, "wb") as fh:
                 fh.write(data)
@@ -404,6 +418,10 @@ def _in_child_process(read, path, reader):
     _, status = os.waitpid(pid, 0)
     what = _FORMATS.get(path.suffix.lower(), f"{path.suffix} file")
     if os.WIFSIGNALED(status) or os.WEXITSTATUS(status) != 0 or not chunks:
+        if os.WIFSIGNALED(status) and os.WTERMSIG(status) == signal.SIGALRM:
+            raise MeshFileError(f"{path}: could not read it: {reader} did not finish this {what} "
+                                f"within {seconds} s (a parser that loops on a corrupt file): "
+                                f"the file is corrupt or truncated")
         if os.WIFSIGNALED(status):
             sig = os.WTERMSIG(status)
             try:

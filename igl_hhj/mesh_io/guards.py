@@ -12,7 +12,7 @@ import numpy as np
 from ..errors import MeshFileError
 from ..polygon_io import EXTRA_EXTENSIONS
 from .extensions import MESH_EXTENSIONS, READ_EXTENSIONS
-from .scan import _Lines, _check_rows, _first_bad, _line_tokens, _too_short
+from .scan import _Lines, _check_rows, _first_bad, _line_tokens, _long_lines, _too_short
 
 
 _HEADER_BYTES = 1 << 16
@@ -38,8 +38,26 @@ def _check_input_file(path):
     except OSError as exc:
         raise MeshFileError(f"{path}: cannot read: {exc.strerror or exc}") from None
     if not head.strip():
-        raise MeshFileError(f"{path}: file is empty")
+        _check_blank(path, head)
     return path, ext, head
+
+
+def _check_blank(path, head):
+    """The first bytes are blank: an empty file, or one of blanks only, is refused in words;
+    one with a mesh after a blank start goes on."""
+    if not head:
+        raise MeshFileError(f"{path}: the file is empty (0 bytes): there is no mesh in it")
+    with open(path, "rb") as fh:
+        fh.seek(len(head))
+        while True:
+            block = fh.read(1 << 22)
+            if not block:
+                break
+            if block.strip():
+                return
+    size = path.stat().st_size
+    raise MeshFileError(f"{path}: the file holds only blanks (spaces, tabs, line breaks; {size} "
+                        f"bytes): there is no mesh in it")
 
 
 def _check_off_body(path, nV, nF):
@@ -136,14 +154,26 @@ def _check_obj(path):
     return (L.ntok - 1)[f]
 
 
+STL_LINE_LIMIT = 256
+"""libigl's ascii STL reader reads a line into a 256-byte buffer (``std::istream::getline``): on a
+line of 256 bytes or more the stream fails without reaching its end and the reader loops
+forever.  :func:`_check_stl` refuses (or trims, after ``endsolid``) such lines first."""
+
+
 def _check_stl(path, head, size):
-    """Binary STL: 84 + 50 × count bytes exactly; ascii STL: numeric vertex lines."""
+    """Binary STL: 84 + 50 × count bytes exactly; ascii STL: numeric vertex lines and no
+    line libigl's reader would loop on (:data:`STL_LINE_LIMIT`).
+
+    Returns None, or for an ascii STL whose over-long lines all come after its last
+    ``endsolid`` line (an interrupted copy padded with NUL bytes, text appended to the
+    file), ``(keep, note)``: read the first ``keep`` bytes followed by ``endsolid``, and say
+    ``note``."""
     if size >= 84:
         n = int(np.frombuffer(head[80:84], dtype="<u4")[0]) if len(head) >= 84 else -1
         if n >= 0 and 84 + 50 * n == size:
             if n == 0:
                 raise MeshFileError(f"{path}: binary STL with 0 triangles")
-            return
+            return None
     if not head.lstrip().lower().startswith(b"solid"):
         n = int(np.frombuffer(head[80:84], dtype="<u4")[0]) if len(head) >= 84 else 0
         raise MeshFileError(f"{path}: not an STL file: a binary STL declaring {n} triangles needs "
@@ -158,6 +188,29 @@ def _check_stl(path, head, size):
     if nv == 0 or nv % 3:
         raise MeshFileError(f"{path}: ascii STL with {nv} vertex lines (need a positive multiple "
                             f"of 3: three per facet); truncated or corrupt")
+    return _stl_long_lines(path, L, size)
+
+
+def _stl_long_lines(path, L, size):
+    offset, length, lineno = _long_lines(path, STL_LINE_LIMIT)
+    if not offset.size:
+        return None
+    last_end = None                                # the last 'endsolid' line: offset, number
+    with open(path, "rb") as fh:
+        for i in np.flatnonzero((L.c0 == ord("e")) & (L.flen >= 8))[::-1]:
+            fh.seek(int(L.offset[i]))
+            if fh.read(1 << 16).lstrip().startswith(b"endsolid"):
+                last_end = (int(L.offset[i]), int(L.lineno[i]))
+                break
+    why = (f"libigl's ascii STL reader reads at most {STL_LINE_LIMIT - 1} bytes a line (a longer "
+           f"one makes it loop forever)")
+    if last_end is None or offset[0] < last_end[0]:
+        raise MeshFileError(f"{path}: line {int(lineno[0])} is {int(length[0])} bytes long"
+                            + (f" ({offset.size} such lines)" if offset.size > 1 else "")
+                            + f": {why}; shorten or remove it")
+    keep = last_end[0]
+    return keep, (f"ignored the {size - keep} bytes from line {last_end[1]} ('endsolid') on, "
+                  f"which hold a line of {int(length[0])} bytes: {why}")
 
 
 def _msh_binary_header(path):

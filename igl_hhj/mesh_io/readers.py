@@ -120,18 +120,34 @@ def _read_without_bom(path):
     """A UTF-8 byte-order mark in front of an OBJ / OFF / PLY: libigl would lose the first
     line (OBJ: the first vertex, then a misleading index error) or reject the file, so read
     a copy without the three bytes; messages name the original file."""
+    return _read_copy(path, len(_BOM), None, b"")
+
+
+def _read_copy(path, start, stop, tail, note=None):
+    """Read a copy of bytes ``start:stop`` of ``path`` followed by ``tail`` (the guards' repair
+    of what libigl cannot read); messages name the original file, ``note`` is added to them."""
     import shutil
-    tmpdir = tempfile.mkdtemp(prefix="igl_hhj_bom_")
+    tmpdir = tempfile.mkdtemp(prefix="igl_hhj_copy_")
     copy = Path(tmpdir) / path.name
     try:
         with open(path, "rb") as src, open(copy, "wb") as dst:
-            src.seek(len(_BOM))
-            shutil.copyfileobj(src, dst, 1 << 20)
+            src.seek(start)
+            left = None if stop is None else stop - start
+            while left is None or left > 0:
+                block = src.read(1 << 20 if left is None else min(1 << 20, left))
+                if not block:
+                    break
+                dst.write(block)
+                if left is not None:
+                    left -= len(block)
+            dst.write(tail)
         _, ext, head = _check_input_file(copy)
         try:
-            return _read_checked(copy, ext, head)
+            mf = _read_checked(copy, ext, head)
         except MeshFileError as exc:
             raise MeshFileError(str(exc).replace(str(copy), str(path))) from None
+        mf.messages = [m.replace(str(copy), str(path)) for m in mf.messages] + ([note] if note else [])
+        return mf
     finally:
         shutil.rmtree(tmpdir, ignore_errors=True)
 
@@ -150,7 +166,9 @@ def _read_checked(path, ext, head):
     elif ext == ".obj":
         sizes = _check_obj(path)
     elif ext == ".stl":
-        _check_stl(path, head, size)
+        trim = _check_stl(path, head, size)
+        if trim is not None:                         # a tail libigl would loop on
+            return _read_copy(path, 0, trim[0], b"endsolid\n", trim[1])
     elif ext in (".mesh", ".msh"):
         _check_keyword_counts(path, size)
     import igl

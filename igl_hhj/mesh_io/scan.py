@@ -229,6 +229,36 @@ class _Lines:
         return txt + ("..." if len(raw) > limit else "")
 
 
+def _long_lines(path, limit):
+    """The lines of at least ``limit`` bytes (line break excluded; every byte counts, blanks
+    and NUL too), streamed in ``_CHUNK`` blocks: ``(offset, length, lineno)`` int64 arrays,
+    one entry per such line in file order.  Memory O(``_CHUNK``) plus O(such lines)."""
+    offsets, lengths, linenos = [], [], []
+    start, lineno, pos = 0, 1, 0                   # the current line's offset and number
+    with open(path, "rb") as fh:
+        while True:
+            block = fh.read(_CHUNK)
+            if not block:
+                break
+            nl = np.flatnonzero(np.frombuffer(block, dtype=np.uint8) == 10) + pos
+            if nl.size:
+                begins = np.concatenate([[start], nl[:-1] + 1])
+                length = nl - begins
+                long = np.flatnonzero(length >= limit)
+                offsets.append(begins[long])
+                lengths.append(length[long])
+                linenos.append(long + lineno)
+                start, lineno = int(nl[-1]) + 1, lineno + nl.size
+            pos += len(block)
+    if pos - start >= limit:                       # the last line, without a line break
+        offsets.append(np.array([start]))
+        lengths.append(np.array([pos - start]))
+        linenos.append(np.array([lineno]))
+    cat = [np.concatenate(x).astype(np.int64) if x else np.zeros(0, dtype=np.int64)
+           for x in (offsets, lengths, linenos)]
+    return tuple(cat)
+
+
 def _first_bad(path, lines, bad, what):
     """Raise MeshFileError naming the first line where ``bad`` holds."""
     i = int(np.flatnonzero(bad)[0])
