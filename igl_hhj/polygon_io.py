@@ -398,6 +398,8 @@ def _in_child_process(read, path, reader):
             null = os.open(os.devnull, os.O_WRONLY)
             os.dup2(null, 1)                               # a crash's last words stay quiet
             os.dup2(null, 2)
+            import faulthandler
+            faulthandler.disable()                         # its own copy of stderr: quiet too
             _limit_memory(size)
             signal.signal(signal.SIGALRM, signal.SIG_DFL)  # the alarm kills, whatever the parser does
             signal.alarm(seconds)

@@ -6,7 +6,7 @@ import glob
 import os
 from pathlib import Path
 
-from ..mesh_io import MESH_EXTENSIONS
+from ..mesh_io import READ_EXTENSIONS
 from .jobs import TMP_MARK, Job
 
 
@@ -21,11 +21,14 @@ GROUP_MAX = 16
 
 
 def _is_mesh(p):
-    return p.is_file() and p.suffix.lower() in MESH_EXTENSIONS
+    """A file the readers read (:data:`igl_hhj.mesh_io.READ_EXTENSIONS`: libigl's formats and
+    those of the optional packages; a file whose package is missing becomes an error row
+    naming the install, never a silent skip)."""
+    return p.is_file() and p.suffix.lower() in READ_EXTENSIONS
 
 
 def collect_inputs(inputs):
-    """Expand files, folders (recursively, mesh extensions only) and glob patterns.
+    """Expand files, folders (recursively, :data:`igl_hhj.mesh_io.READ_EXTENSIONS` only) and glob patterns.
 
     Returns a list of ``(path, root)``: ``root`` is the folder the output path is made
     relative to (the folder given, or the file's own folder).  A path that does not exist
@@ -39,7 +42,7 @@ def collect_inputs(inputs):
         if p.is_dir():
             files = sorted(q for q in p.rglob("*") if _is_mesh(q) and TMP_MARK not in q.name)
             if not files:
-                raise ValueError(f"{item}: no mesh files ({', '.join(MESH_EXTENSIONS)}) in this folder")
+                raise ValueError(f"{item}: no mesh files ({', '.join(READ_EXTENSIONS)}) in this folder")
             found += [(q, p) for q in files]
         elif p.exists() or not glob.has_magic(item):
             found.append((p, p.parent))

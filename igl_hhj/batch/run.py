@@ -198,7 +198,7 @@ def run_batch(inputs, outdir, *, scheduler=None, workers=None, method="hhj", per
     Parameters
     ----------
     inputs : list of str or os.PathLike
-        Files, folders (searched recursively for :data:`igl_hhj.mesh_io.MESH_EXTENSIONS`)
+        Files, folders (searched recursively for :data:`igl_hhj.mesh_io.READ_EXTENSIONS`)
         or glob patterns (``**`` allowed).
     outdir : str or os.PathLike
         Created if needed; see :func:`plan_jobs` for the output names.

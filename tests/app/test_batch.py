@@ -522,3 +522,53 @@ def test_warnings_reach_the_summary_and_stderr(collection, tmp_path, capsys, wor
     # a resumed run skips the mesh: no warning printed again
     assert cli.main(["batch", str(bad), str(good[0]), "-o", str(out), "--workers", workers, "-q"]) == 0
     assert "warning" not in capsys.readouterr().err
+
+
+# --------------------------------------------------------------------------- hostile files
+def test_batch_dir_reads_every_readable_format_and_survives_hostile_files(tmp_path, monkeypatch, capsys):
+    """``batch DIR`` picks files by the readers' own extensions (``.vtp`` ``.vtk`` ``.stl`` ...
+    were skipped silently), and in-process a reader that crashes (VTK aborting on 10^12
+    declared points), loops (a parser that never returns) or a file libigl would loop on (an
+    ascii STL with a 300-byte line) is that file's error row while the others finish."""
+    pytest.importorskip("pyvista")
+    from igl_hhj import polygon_io
+    from igl_hhj.mesh_io import READ_EXTENSIONS
+    from igl_hhj.surfaces import icosphere
+    from igl_hhj.vtk_files import write_vtk
+    from igl_hhj.batch.plan import collect_inputs
+    V, F = icosphere(1)
+    folder = tmp_path / "in"
+    folder.mkdir()
+    igl.write_triangle_mesh(str(folder / "a.off"), V, F)
+    write_vtk(folder / "b.vtp", V, F)
+    text = (folder / "b.vtp").read_text()
+    (folder / "crash.vtp").write_text(text.replace(f'NumberOfPoints="{len(V)}"', 'NumberOfPoints="1000000000000"'))
+    write_vtk(folder / "loop.vtu", V, F)
+    igl.write_triangle_mesh(str(folder / "long.stl"), V, F, igl.FileEncoding.Ascii)
+    data = (folder / "long.stl").read_bytes()
+    (folder / "long.stl").write_bytes(data.replace(b"\n", b" " * 300 + b"\n", 1))
+    (folder / "notes.txt").write_text("not a mesh\n")
+    for ext in READ_EXTENSIONS:                    # the folder search goes by READ_EXTENSIONS
+        (tmp_path / "probe").mkdir(exist_ok=True)
+        (tmp_path / "probe" / f"x{ext.upper()}").write_bytes(b"")
+    assert len(collect_inputs([tmp_path / "probe"])) == len(READ_EXTENSIONS)
+
+    read = polygon_io._read_pyvista
+
+    def looping_on_loop(path):
+        while "loop" in path.name:
+            time.sleep(0.01)
+        return read(path)
+    monkeypatch.setattr(polygon_io, "_read_pyvista", looping_on_loop)
+    monkeypatch.setattr(polygon_io, "READER_SECONDS", (2, 1 << 40))
+    out = tmp_path / "out"
+    t0 = time.monotonic()
+    assert cli.main(["batch", str(folder), "-o", str(out), "--workers", "0", "-q"]) == 1
+    assert time.monotonic() - t0 < 60
+    rows = {Path(p).name: r for p, r in read_summary(out).items()}
+    assert set(rows) == {"a.off", "b.vtp", "crash.vtp", "loop.vtu", "long.stl"}
+    assert rows["a.off"]["status"] == rows["b.vtp"]["status"] == "ok"
+    assert rows["a.off"]["faces"] == rows["b.vtp"]["faces"] == str(len(F))
+    assert rows["crash.vtp"]["status"] == "error" and "pyvista failed on this" in rows["crash.vtp"]["error"]
+    assert rows["loop.vtu"]["status"] == "error" and "did not finish" in rows["loop.vtu"]["error"]
+    assert rows["long.stl"]["status"] == "error" and "line 1 is" in rows["long.stl"]["error"]
