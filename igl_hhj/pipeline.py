@@ -216,8 +216,17 @@ def _repaired_dropin(exc, V, F, radius, useKring, opts):
     R, out = on_repaired_mesh(exc, V, F, opts.data_dict(), lambda V2, F2, data: principal_curvature(
         V2, F2, radius, useKring, opts.on_repaired(data), repair_defects=False),
         "principal curvatures", count_lost=True, stacklevel=6)
+    PD1, PD2, PV1, PV2, bad = repaired_values_to_caller(R, out)
+    return PD1, PD2, PV1, PV2, np.flatnonzero(bad).tolist()
+
+
+def repaired_values_to_caller(R, out):
+    """The principal values computed on the repaired mesh ``R`` (``out[:4]``, None when every
+    face was dropped) on the caller's rows: ``(PD1, PD2, PV1, PV2, bad (#V,) bool)``.  The
+    vertices of a two-sided patch get no value (no side is "out" there: no sign), nor do
+    caller vertices that lost every face; their rows are NaN."""
     PD1, PD2, PV1, PV2 = out[:4] if out is not None else (np.zeros((0, 3)),) * 2 + (np.zeros(0),) * 2
-    two_sided = repair.two_sided_vertices(R)          # no side is "out" there: no sign, no value
+    two_sided = repair.two_sided_vertices(R)
     if two_sided.any():
         for a in (PD1, PD2, PV1, PV2):
             a[two_sided] = np.nan
@@ -225,7 +234,7 @@ def _repaired_dropin(exc, V, F, radius, useKring, opts):
     bad = ~(np.isfinite(PD1).all(axis=1) & np.isfinite(PD2).all(axis=1) & np.isfinite(PV1) & np.isfinite(PV2))
     for a in (PD1, PD2, PV1, PV2):
         a[bad] = np.nan
-    return PD1, PD2, PV1, PV2, np.flatnonzero(bad).tolist()
+    return PD1, PD2, PV1, PV2, bad
 
 
 def on_repaired_mesh(exc, V, F, data, compute, what, *, count_lost=False, stacklevel=2):

@@ -117,9 +117,9 @@ def tile_values(V, F, params, real_boundary=None):
         ``warnings``: the messages of the warnings the computation raised (a repair's
         :class:`igl_hhj.mesh.MeshWarning`), in order, without duplicates.
     """
-    from .. import kernels, repair
+    from .. import kernels
     from ..mesh import MeshDefectError, as_mesh
-    from ..pipeline import on_repaired_mesh
+    from ..pipeline import on_repaired_mesh, repaired_values_to_caller
     radius_of = []
 
     def on_arrays(V2, F2, data):
@@ -134,12 +134,7 @@ def tile_values(V, F, params, real_boundary=None):
         except MeshDefectError as exc:         # repairable: as the drop-in (stage 3 | repair)
             data = dict(boundary_normals=None, boundary_shape_operator=None, simply_supported=None)
             R, out = on_repaired_mesh(exc, V, F, data, on_arrays, "principal curvatures", count_lost=True)
-            PD1, PD2, PV1, PV2 = out[:4] if out is not None else (np.zeros((0, 3)),) * 2 + (np.zeros(0),) * 2
-            PD1, PD2, PV1, PV2 = repair.vertex_values_to_caller(R, PD1, PD2, PV1, PV2)
-            bad = ~(np.isfinite(PD1).all(axis=1) & np.isfinite(PD2).all(axis=1) & np.isfinite(PV1)
-                    & np.isfinite(PV2))
-            for a in (PD1, PD2, PV1, PV2):
-                a[bad] = np.nan
+            PD1, PD2, PV1, PV2, _ = repaired_values_to_caller(R, out)
             rmax = float(np.max(radius_of[0])) if radius_of and len(radius_of[0]) else 0.0
             r = np.full(len(F), rmax)
         else:

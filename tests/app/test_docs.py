@@ -8,7 +8,10 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
+
+import igl_hhj
 
 from test_readme import bunny_folder, python_blocks, run_blocks
 
@@ -109,6 +112,22 @@ def test_page_python_runs_as_written(tmp_path, page):
         assert (folder / "curvatures" / "bunny.npz").stat().st_size > 0
 
 
+@pytest.mark.slow
+def test_tiled_python_runs_as_written(tmp_path):
+    """The tiled page's example on a generated mesh (scan.ply: a perturbed ellipsoid),
+    its outputs the drop-in's on the whole mesh."""
+    import igl
+    from igl_hhj.surfaces import standard_sequence
+    _, meshes = standard_sequence("ellipsoid", 3)
+    V, F = meshes[-1]
+    igl.write_triangle_mesh(str(tmp_path / "scan.ply"), V, F)
+    run_blocks(python_blocks(page_text("tiled.md")), tmp_path, "tiled.md")
+    V, F = igl.read_triangle_mesh(str(tmp_path / "scan.ply"))
+    PV1 = np.load(tmp_path / "scan_curvature" / "PV1.npy")
+    ref = igl_hhj.principal_curvature(V, F)[2]
+    np.testing.assert_allclose(PV1, ref, atol=1e-6 * np.abs(ref).max())
+
+
 def _walker_md_last_rows():
     """k = 4 rows of demos/images/walker_tables.md (ours, paper) per surface with boundary data."""
     text = (IMAGES / "walker_tables.md").read_text(encoding="utf-8")
@@ -168,7 +187,8 @@ PYTHON_BLOCK_TESTS = {"README.md": "test_readme_python_runs_as_written",
                       "tutorial.md": "test_tutorial_python_runs_as_written",
                       "papers.md": "test_page_python_runs_as_written",
                       "batch.md": "test_page_python_runs_as_written",
-                      "features.md": "test_features_python_runs_as_written"}
+                      "features.md": "test_features_python_runs_as_written",
+                      "tiled.md": "test_tiled_python_runs_as_written"}
 #: ```bash / ```text blocks are not run here: the README's set-up commands need the network
 #: (pip install; CI runs them: .ci/run), cli.md's block is --help output (checked against the
 #: parser in test_readme.py), batch.md's and contributing.md's commands start clusters or CI.
