@@ -289,11 +289,11 @@ the Python wrappers reserve a few hundred MB).  A file declaring more than that 
 with a :class:`MeshFileError` instead of exhausting the machine's memory."""
 
 
-READER_SECONDS = (60, 10 << 20)
+READER_SECONDS = (60, 1 << 20)
 """``(t, r)``: a child process parsing a file of ``s`` bytes is killed after ``t + s / r``
-seconds (60 s, plus one per 10 MB): a parser that loops on a hostile file, or a child
-that deadlocks after ``fork`` in a process with threads, becomes a :class:`MeshFileError`
-instead of a hang of the caller."""
+seconds (60 s, plus one per MB, which a slow parser of a large ascii file stays within): a
+parser that loops on a hostile file, or a child that deadlocks after ``fork`` in a process
+with threads, becomes a :class:`MeshFileError` instead of a hang of the caller."""
 
 
 def _reader_seconds(size):

@@ -66,10 +66,7 @@ def valid_files(tmp):
                       f"property double y\nproperty double z\nelement face {len(F)}\n"
                       "property list uchar int vertex_indices\nend_header\n").encode() + \
         V.astype("<f8").tobytes() + rec.tobytes()
-    tri = V[F]
-    out["ascii.stl"] = ("solid s\n" + "".join(
-        "facet normal 0 0 0\nouter loop\n" + "".join(f"vertex {float(p[0])!r} {float(p[1])!r} {float(p[2])!r}\n" for p in t)
-        + "endloop\nendfacet\n" for t in tri) + "endsolid s\n").encode()
+    out["ascii.stl"] = _ascii_stl()
     out["s.wrl"] = ("#VRML V2.0 utf8\nShape {\ngeometry IndexedFaceSet {\ncoord Coordinate {\npoint [\n"
                     + ",\n".join(f"{float(x)!r} {float(y)!r} {float(z)!r}" for x, y, z in V) + "\n]\n}\ncoordIndex [\n"
                     + ",\n".join(f"{a}, {b}, {c}, -1" for a, b, c in F) + "\n]\n}\n}\n").encode()
